@@ -1,0 +1,7 @@
+//! One module per subcommand; each exposes `XArgs` (clap) and `run(XArgs) -> anyhow::Result<()>`.
+
+pub mod demo;
+pub mod identify;
+pub mod paper;
+pub mod plot;
+pub mod simulate;

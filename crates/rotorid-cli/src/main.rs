@@ -1,0 +1,45 @@
+//! `rotorid`: simulate rotor-bearing vibration and identify its physical parameters.
+//!
+//! A thin entry point: parse the command line, run one command, and print any error as
+//! `Error: {:#}` with a non-zero exit code.
+
+use clap::{Parser, Subcommand};
+
+mod commands;
+
+/// Identify the mass, damping and stiffness of a rotor-bearing system from its vibration.
+#[derive(Debug, Parser)]
+#[command(name = "rotorid", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Simulate the rotor's response x(t), z(t) and write it as CSV.
+    Simulate(commands::simulate::SimulateArgs),
+    /// Identify m, c, k in both directions from a response CSV (a file or a live pipe).
+    Identify(commands::identify::IdentifyArgs),
+    /// Simulate the paper's rotor, identify it, and print a table beside the paper's figures.
+    Demo(commands::demo::DemoArgs),
+    /// Reproduce the paper's figures 2-9 and results as images and a report.
+    Paper(commands::paper::PaperArgs),
+    /// Plot a simulate or identify CSV as PNG or SVG.
+    Plot(commands::plot::PlotArgs),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Simulate(args) => commands::simulate::run(args),
+        Command::Identify(args) => commands::identify::run(args),
+        Command::Demo(args) => commands::demo::run(args),
+        Command::Paper(args) => commands::paper::run(args),
+        Command::Plot(args) => commands::plot::run(args),
+    };
+    if let Err(err) = result {
+        eprintln!("Error: {err:#}");
+        std::process::exit(1);
+    }
+}

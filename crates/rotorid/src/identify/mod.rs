@@ -1,0 +1,1 @@
+//! Identifiers (placeholder until the identify module lands).

@@ -1,0 +1,1 @@
+//! Maximum-likelihood refinement (placeholder until the refine module lands).

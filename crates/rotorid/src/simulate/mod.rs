@@ -1,0 +1,1 @@
+//! Simulators (placeholder until the simulate module lands).
