@@ -1,7 +1,73 @@
-//! Benchmarks for `identify` (placeholder until the module lands).
-use criterion::{criterion_group, criterion_main, Criterion};
+//! Streaming throughput of the algebraic identifier (both directions, one estimate per
+//! sample): general (variable speed) and constant-speed mode, default (am5) and trapezoid
+//! quadrature. Goal: >= 20 million samples/s on one core.
+//!
+//! Run: `cargo bench -p rotorid --bench identify`.
 
-fn placeholder(_c: &mut Criterion) {}
+use std::hint::black_box;
+use std::time::Duration;
 
-criterion_group!(benches, placeholder);
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use rotorid::identify::{
+    measurement, AlgebraicIdentifier, IdentifierConfig, Known, Measurement, Quadrature, SpeedModel,
+};
+use rotorid::simulate::{simulate, Method};
+use rotorid::{Sampling, Scenario};
+
+/// One second of table1 data at dt = 0.1 ms (10 001 samples), simulated outside the timing.
+fn data(scenario: Scenario) -> Vec<Measurement> {
+    let mut sc = scenario;
+    sc.sampling = Sampling::new(1e-4, 1.0).expect("valid sampling");
+    let resp = simulate(&sc, Method::Newmark).expect("simulation");
+    (0..resp.len()).map(|i| measurement(&resp, i)).collect()
+}
+
+fn run(id: &AlgebraicIdentifier, data: &[Measurement]) -> f64 {
+    let mut id = id.clone();
+    let mut acc = 0.0;
+    for m in data {
+        let e = id.push(black_box(m)).expect("valid data");
+        acc += e.x.k + e.z.k;
+    }
+    acc
+}
+
+fn bench(c: &mut Criterion) {
+    let ramp = Scenario::table1_ramp(0.0).expect("valid ramp");
+    let constant = Scenario::table1();
+    let known = Known::from_rotor(&constant.rotor);
+    let ramp_data = data(ramp);
+    let const_data = data(constant);
+    let w = rotorid::model::rpm_to_rad_per_s(1200.0);
+
+    let mut g = c.benchmark_group("identify");
+    g.throughput(Throughput::Elements(const_data.len() as u64))
+        .sample_size(20)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(3));
+    for q in [Quadrature::AdamsMoulton5, Quadrature::Trapezoid] {
+        let general = IdentifierConfig {
+            quadrature: q,
+            ..IdentifierConfig::default()
+        };
+        let constant = IdentifierConfig {
+            speed_model: SpeedModel::Constant {
+                omega: w,
+                phi0: 0.0,
+            },
+            ..general
+        };
+        let id_g = AlgebraicIdentifier::new(known, 1e-4, general).expect("valid");
+        let id_c = AlgebraicIdentifier::new(known, 1e-4, constant).expect("valid");
+        g.bench_function(format!("general/{q}"), |b| {
+            b.iter(|| run(&id_g, &ramp_data))
+        });
+        g.bench_function(format!("constant/{q}"), |b| {
+            b.iter(|| run(&id_c, &const_data))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
 criterion_main!(benches);

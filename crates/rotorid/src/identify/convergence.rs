@@ -1,0 +1,380 @@
+//! When did the identifier converge? A streaming, bounded-memory answer.
+//!
+//! For each parameter (m_x, c_x, k_x, m_z, c_z, k_z), over the well-conditioned instants
+//! only (rcond >= rcond_min, [`super::DirectionEstimate::well_conditioned`]):
+//!
+//! ```text
+//! final                = v_last, the value at the last well-conditioned instant
+//! band                 = [F - d, F + d],  F = final, d = tol |F|
+//! identification_time  = min { t_k : F - d <= v_j <= F + d for every j >= k }
+//! ```
+//!
+//! i.e. the earliest well-conditioned instant from which every later well-conditioned
+//! estimate stays within `tol` (relative) of the final value.
+//!
+//! ## Algorithm
+//!
+//! Per parameter, two monotone stacks ("staircases") hold the suffix maxima and suffix
+//! minima of the sequence: pushing v pops every entry <= v (resp. >= v), so the stack lists
+//! the instants whose value exceeds everything after them. At the end, the last entry
+//! above F + d (resp. below F - d) is found by scanning from the top; the answer is the
+//! instant right after it. O(1) amortised per estimate; the answer costs O(stack).
+//!
+//! ## Bounded memory and its price
+//!
+//! A stack is capped (default [`DEFAULT_STACK_CAPACITY`] entries; a steadily drifting
+//! sequence would otherwise keep every sample). When full, adjacent entries are merged, the
+//! pairs whose values are closest first: a merged entry keeps the larger value (for the
+//! max stack; the smaller for the min stack) and the later time, so it claims "a value
+//! this far out occurs this late" -- the reported time can only get LATER than the exact
+//! one, never earlier. With Delta the largest value range ever merged
+//! ([`ParameterConvergence::resolution`], same unit as the parameter, 0 when nothing was
+//! merged):
+//!
+//! ```text
+//! T_exact(band [F - d, F + d]) <= T_reported <= T_exact(band [F - d + Delta, F + d - Delta])
+//! ```
+//!
+//! so the answer is exact for a tolerance somewhere between tol - Delta/|F| and tol.
+
+use serde::Serialize;
+
+use super::config::IdentifierConfig;
+use super::error::{check, IdentifyError};
+use super::estimate::Estimate;
+
+/// Default relative tolerance of the convergence band (1 %).
+pub const DEFAULT_TOLERANCE: f64 = 0.01;
+/// Default cap on each staircase (entries); 6 parameters x 2 stacks x 32 bytes x 4096 =
+/// 1.5 MiB at most.
+pub const DEFAULT_STACK_CAPACITY: usize = 4096;
+
+/// One of the six identified parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum Parameter {
+    /// Mass from the x direction [kg].
+    Mx,
+    /// Damping cx [N s/m].
+    Cx,
+    /// Stiffness kx [N/m].
+    Kx,
+    /// Mass from the z direction [kg].
+    Mz,
+    /// Damping cz [N s/m].
+    Cz,
+    /// Stiffness kz [N/m].
+    Kz,
+}
+
+impl Parameter {
+    /// All six, in the order of [`Estimate::values`].
+    pub const ALL: [Parameter; 6] = [
+        Parameter::Mx,
+        Parameter::Cx,
+        Parameter::Kx,
+        Parameter::Mz,
+        Parameter::Cz,
+        Parameter::Kz,
+    ];
+
+    /// `m_x`, `c_x`, `k_x`, `m_z`, `c_z`, `k_z`.
+    pub fn name(self) -> &'static str {
+        ["m_x", "c_x", "k_x", "m_z", "c_z", "k_z"][self.index()]
+    }
+
+    /// Its unit: `kg`, `N s/m` or `N/m`.
+    pub fn unit(self) -> &'static str {
+        ["kg", "N s/m", "N/m"][self.index() % 3]
+    }
+
+    /// Position in [`Parameter::ALL`] and [`Estimate::values`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// The convergence summary of one parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ParameterConvergence {
+    /// Which parameter.
+    pub parameter: Parameter,
+    /// Value at the last well-conditioned instant (unit of the parameter); None if there
+    /// was none.
+    pub final_value: Option<f64>,
+    /// Time of that instant [s].
+    pub final_t: Option<f64>,
+    /// Earliest well-conditioned instant from which every well-conditioned estimate stays
+    /// within the tolerance of the final value [s]; None if there was no well-conditioned
+    /// instant.
+    pub identification_time: Option<f64>,
+    /// Number of well-conditioned instants seen.
+    pub well_conditioned: u64,
+    /// Largest value range merged when a staircase was full (unit of the parameter; 0 when
+    /// the answer is exact). See the module docs for what it bounds.
+    pub resolution: f64,
+}
+
+/// A staircase entry: the newest original instant it stands for (time `t`, followed by
+/// the instant `t_next`), the extreme value `rep` of the instants merged into it and the
+/// opposite extreme `lo`.
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    t: f64,
+    t_next: f64,
+    rep: f64,
+    lo: f64,
+}
+
+/// Suffix maxima of a sequence, capped (module docs).
+#[derive(Debug, Clone)]
+struct Staircase {
+    steps: Vec<Step>,
+    cap: usize,
+    resolution: f64,
+    spans: Vec<f64>,
+}
+
+impl Staircase {
+    fn new(cap: usize) -> Self {
+        Self {
+            steps: Vec::new(),
+            cap,
+            resolution: 0.0,
+            spans: Vec::new(),
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, t: f64, v: f64) {
+        if let Some(top) = self.steps.last_mut() {
+            if top.t_next.is_nan() {
+                top.t_next = t;
+            }
+        }
+        while self.steps.last().is_some_and(|s| s.rep <= v) {
+            self.steps.pop();
+        }
+        if self.steps.len() >= self.cap {
+            self.compact();
+        }
+        self.steps.push(Step {
+            t,
+            t_next: f64::NAN,
+            rep: v,
+            lo: v,
+        });
+    }
+
+    /// Merge adjacent pairs whose merged range is at most the median range (each entry in
+    /// at most one merge): frees at least ~1/6 of the stack, O(cap).
+    #[cold]
+    fn compact(&mut self) {
+        let n = self.steps.len();
+        if n < 2 {
+            return;
+        }
+        let span = |a: &Step, b: &Step| a.rep - a.lo.min(b.lo);
+        self.spans.clear();
+        self.spans
+            .extend(self.steps.windows(2).map(|w| span(&w[0], &w[1])));
+        let mid = self.spans.len() / 2;
+        let threshold = *self.spans.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let mut write = 0;
+        let mut i = 0;
+        while i < n {
+            let cur = self.steps[i];
+            if i + 1 < n && span(&cur, &self.steps[i + 1]) <= threshold {
+                let next = self.steps[i + 1];
+                let merged = Step {
+                    t: next.t,
+                    t_next: next.t_next,
+                    rep: cur.rep,
+                    lo: cur.lo.min(next.lo),
+                };
+                self.resolution = self.resolution.max(merged.rep - merged.lo);
+                self.steps[write] = merged;
+                i += 2;
+            } else {
+                self.steps[write] = cur;
+                i += 1;
+            }
+            write += 1;
+        }
+        self.steps.truncate(write);
+    }
+
+    /// The instant after the newest entry above `hi` (None when no entry is above `hi`).
+    fn after_last_above(&self, hi: f64) -> Option<f64> {
+        self.steps
+            .iter()
+            .rev()
+            .find(|s| s.rep > hi)
+            .map(|s| s.t_next)
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Track {
+    /// Suffix maxima of v.
+    max: Staircase,
+    /// Suffix maxima of -v (suffix minima of v).
+    min: Staircase,
+    first_t: f64,
+    last_t: f64,
+    last_v: f64,
+    count: u64,
+}
+
+impl Track {
+    fn new(cap: usize) -> Self {
+        Self {
+            max: Staircase::new(cap),
+            min: Staircase::new(cap),
+            first_t: f64::NAN,
+            last_t: f64::NAN,
+            last_v: f64::NAN,
+            count: 0,
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, t: f64, v: f64) {
+        if self.count == 0 {
+            self.first_t = t;
+        }
+        self.max.push(t, v);
+        self.min.push(t, -v);
+        self.last_t = t;
+        self.last_v = v;
+        self.count += 1;
+    }
+
+    fn result(&self, parameter: Parameter, tol: f64) -> ParameterConvergence {
+        let resolution = self.max.resolution.max(self.min.resolution);
+        if self.count == 0 {
+            return ParameterConvergence {
+                parameter,
+                final_value: None,
+                final_t: None,
+                identification_time: None,
+                well_conditioned: 0,
+                resolution,
+            };
+        }
+        let f = self.last_v;
+        let d = tol * f.abs();
+        let (hi, lo) = (f + d, f - d);
+        let after_max = self.max.after_last_above(hi);
+        let after_min = self.min.after_last_above(-lo);
+        let start = match (after_max, after_min) {
+            (None, None) => Some(self.first_t),
+            (a, b) => {
+                let t = a
+                    .unwrap_or(f64::NEG_INFINITY)
+                    .max(b.unwrap_or(f64::NEG_INFINITY));
+                // t_next is always set for an entry below the top; NaN would be a bug.
+                t.is_finite().then_some(t)
+            }
+        };
+        ParameterConvergence {
+            parameter,
+            final_value: Some(f),
+            final_t: Some(self.last_t),
+            identification_time: start,
+            well_conditioned: self.count,
+            resolution,
+        }
+    }
+}
+
+/// Streaming convergence summary of the six parameters (module docs). Memory is bounded by
+/// the stack capacity whatever the record length.
+#[derive(Debug, Clone)]
+pub struct ConvergenceTracker {
+    tol: f64,
+    rcond_min: f64,
+    tracks: [Track; 6],
+    estimates: u64,
+}
+
+impl ConvergenceTracker {
+    /// A tracker with relative band `tol` (finite, >= 0) that ignores instants with
+    /// rcond < `rcond_min` (in [0, 1]), with the default stack capacity.
+    pub fn new(tol: f64, rcond_min: f64) -> Result<Self, IdentifyError> {
+        Self::with_capacity(tol, rcond_min, DEFAULT_STACK_CAPACITY)
+    }
+
+    /// As [`new`](Self::new) with each of the 12 stacks capped at `capacity` entries
+    /// (>= 2).
+    pub fn with_capacity(tol: f64, rcond_min: f64, capacity: usize) -> Result<Self, IdentifyError> {
+        check("tol", tol, "finite and >= 0 (relative)", |v| v >= 0.0)?;
+        check("rcond_min", rcond_min, "finite and in [0, 1]", |v| {
+            (0.0..=1.0).contains(&v)
+        })?;
+        if capacity < 2 {
+            return Err(IdentifyError::OutOfRange {
+                field: "capacity",
+                value: capacity as f64,
+                allowed: ">= 2 (entries)",
+            });
+        }
+        Ok(Self {
+            tol,
+            rcond_min,
+            tracks: std::array::from_fn(|_| Track::new(capacity)),
+            estimates: 0,
+        })
+    }
+
+    /// The default tolerance ([`DEFAULT_TOLERANCE`]) and the identifier's `rcond_min`.
+    pub fn for_config(config: &IdentifierConfig) -> Result<Self, IdentifyError> {
+        Self::new(DEFAULT_TOLERANCE, config.rcond_min)
+    }
+
+    /// The relative tolerance.
+    pub fn tolerance(&self) -> f64 {
+        self.tol
+    }
+
+    /// The conditioning threshold.
+    pub fn rcond_min(&self) -> f64 {
+        self.rcond_min
+    }
+
+    /// Number of estimates pushed (flagged ones included).
+    pub fn estimates(&self) -> u64 {
+        self.estimates
+    }
+
+    /// Take the next estimate (in time order). Flagged directions are skipped.
+    #[inline]
+    pub fn push(&mut self, e: &Estimate) {
+        self.estimates += 1;
+        let ok = e.well_conditioned(self.rcond_min);
+        let v = e.values();
+        for (i, track) in self.tracks.iter_mut().enumerate() {
+            if ok[i / 3] && v[i].is_finite() {
+                track.push(e.t, v[i]);
+            }
+        }
+    }
+
+    /// Entries held in the 12 staircases now (each at most the capacity): the tracker's
+    /// memory is about 32 bytes times this.
+    pub fn stack_entries(&self) -> usize {
+        self.tracks
+            .iter()
+            .map(|t| t.max.steps.len() + t.min.steps.len())
+            .sum()
+    }
+
+    /// The summary of one parameter so far.
+    pub fn result(&self, p: Parameter) -> ParameterConvergence {
+        self.tracks[p.index()].result(p, self.tol)
+    }
+
+    /// The summaries of all six, in [`Parameter::ALL`] order.
+    pub fn results(&self) -> [ParameterConvergence; 6] {
+        Parameter::ALL.map(|p| self.result(p))
+    }
+}

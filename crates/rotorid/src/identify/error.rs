@@ -1,0 +1,89 @@
+//! Errors of the identifiers. Each variant carries the offending value, sample or name, and
+//! its message states what is allowed, so a user can fix the input without reading code.
+//! A singular or ill-conditioned system is NOT an error (the estimate is NaN / flagged).
+
+/// Why an identifier could not be built or could not take a measurement.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IdentifyError {
+    /// A configuration value or known quantity is outside its allowed range (this includes
+    /// NaN and infinity).
+    #[error("{field} = {value} is out of range: must be {allowed}")]
+    OutOfRange {
+        /// The input's name (e.g. `dt`, `rcond_min`, `known.a`).
+        field: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// The allowed range in words, with its unit.
+        allowed: &'static str,
+    },
+    /// A measurement holds NaN or infinity.
+    #[error("sample {index}: {field} = {value} is not finite (the identifier needs finite measurements)")]
+    NotFinite {
+        /// Index of the sample since the identifier started (0 for the first).
+        index: u64,
+        /// The field's name: `t`, `x`, `z`, `phi`, `phi_dot` or `phi_ddot`.
+        field: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// The sample is not one period after the previous one (or time goes backwards).
+    #[error(
+        "sample {index} at t = {t} s breaks uniform sampling: expected t = {expected} s \
+         within {tolerance:e} s (period dt = {dt} s; allowed jitter 1e-6 dt + 8 ulp(t)); \
+         the identifier needs strictly increasing, uniformly sampled times"
+    )]
+    NonUniformSampling {
+        /// Index of the sample since the identifier started.
+        index: u64,
+        /// Its time [s].
+        t: f64,
+        /// The previous sample's time plus dt [s].
+        expected: f64,
+        /// The allowed deviation from `expected` [s].
+        tolerance: f64,
+        /// The nominal sampling period [s].
+        dt: f64,
+    },
+    /// A record too short to derive the sampling period from.
+    #[error(
+        "the record has {samples} sample(s): at least 2 are needed to derive the sampling period"
+    )]
+    TooFewSamples {
+        /// Number of samples in the record.
+        samples: usize,
+    },
+    /// The columns of a record have different lengths.
+    #[error("column {column} has {len} samples but t has {expected}: every column must have one value per time")]
+    ColumnLength {
+        /// The column's name.
+        column: &'static str,
+        /// Its length.
+        len: usize,
+        /// The length of `t`.
+        expected: usize,
+    },
+    /// A quadrature name that is not known.
+    #[error("unknown quadrature {name:?}: expected \"trapezoid\", \"am3\", \"am4\" or \"am5\"")]
+    UnknownQuadrature {
+        /// The name as given.
+        name: String,
+    },
+}
+
+/// Check `value` with `ok`, or return [`IdentifyError::OutOfRange`] naming `field`.
+pub(crate) fn check(
+    field: &'static str,
+    value: f64,
+    allowed: &'static str,
+    ok: impl Fn(f64) -> bool,
+) -> Result<f64, IdentifyError> {
+    if value.is_finite() && ok(value) {
+        Ok(value)
+    } else {
+        Err(IdentifyError::OutOfRange {
+            field,
+            value,
+            allowed,
+        })
+    }
+}
