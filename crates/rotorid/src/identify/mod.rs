@@ -37,3 +37,4 @@ pub use identifier::{AlgebraicIdentifier, SAMPLING_TOLERANCE};
 pub use inputs::{Known, Measurement};
 pub use quadrature::{Quadrature, RunningIntegrals, LEVELS};
 pub use system::{solve_scaled, ScaledSolution};
+pub mod modulating;
