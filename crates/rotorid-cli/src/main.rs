@@ -6,6 +6,7 @@
 use clap::{Parser, Subcommand};
 
 mod commands;
+mod io;
 
 /// Identify the mass, damping and stiffness of a rotor-bearing system from its vibration.
 #[derive(Debug, Parser)]

@@ -1,0 +1,225 @@
+//! The estimates CSV written by `rotorid identify`: the algebraic identifier's estimate of
+//! theta = (m, c, k) per direction at each (or every N-th) sample (method.md section 5,
+//! `A(t) theta = b(t)`).
+//!
+//! ```text
+//! t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z
+//! s,kg,N s/m,N/m,kg,N s/m,N/m,1,1          (units, not written)
+//! ```
+//!
+//! - `t` is the sample's time as read from the input.
+//! - `rcond_x`, `rcond_z` are the identifier's reciprocal condition numbers of the scaled
+//!   3x3 system A(t) (dimensionless, in [0, 1]; 0 when exactly singular), always written.
+//! - When a direction is not well conditioned at an instant (rcond below `--rcond-min`,
+//!   or A(t) singular, as at t = t_0), its three fields m, c, k are left EMPTY: the
+//!   identifier has no trustworthy estimate there (the paper's "spikes"). Empty fields read
+//!   as NaN in pandas (`read_csv`), numpy (`genfromtxt`) and spreadsheets, and as `None`
+//!   through [`EstimatesReader`] (which also reads `NaN` as `None`).
+//! - Values are written in shortest round-trip form ([`super::number`]).
+
+use std::io::{self, Read, Write};
+
+use csv::ByteRecord;
+
+use super::columns::{
+    check_length, csv_reader, finite_field, number_field, optional_field, read_error, Header,
+};
+use super::csv_error::CsvError;
+use super::number::write_row;
+use super::params::ParameterSet;
+
+/// The header `identify` writes.
+pub const ESTIMATES_HEADER: [&str; 9] = [
+    "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z",
+];
+
+/// One row of the estimates CSV.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EstimateRow {
+    /// Time t [s].
+    pub t: f64,
+    /// The estimates (kg, N s/m, N/m); `None` where the direction is not well conditioned.
+    pub values: ParameterSet<Option<f64>>,
+    /// Reciprocal condition number of the x system (dimensionless, [0, 1]).
+    pub rcond_x: f64,
+    /// Reciprocal condition number of the z system (dimensionless, [0, 1]).
+    pub rcond_z: f64,
+}
+
+/// Writes the estimates CSV (header first), one whole row per `write_all`.
+pub struct EstimatesWriter<W: Write> {
+    out: W,
+    scratch: Vec<u8>,
+}
+
+impl<W: Write> EstimatesWriter<W> {
+    /// Write the header to `out`.
+    pub fn new(mut out: W) -> io::Result<Self> {
+        writeln!(out, "{}", ESTIMATES_HEADER.join(","))?;
+        Ok(Self {
+            out,
+            scratch: Vec::with_capacity(256),
+        })
+    }
+
+    /// Write one row.
+    pub fn write(&mut self, r: &EstimateRow) -> io::Result<()> {
+        let v = r.values;
+        write_row(
+            &mut self.out,
+            &mut self.scratch,
+            &[
+                Some(r.t),
+                v.m_x,
+                v.c_x,
+                v.k_x,
+                v.m_z,
+                v.c_z,
+                v.k_z,
+                Some(r.rcond_x),
+                Some(r.rcond_z),
+            ],
+        )
+    }
+
+    /// The underlying writer (not flushed).
+    #[cfg(test)]
+    pub fn into_inner(self) -> W {
+        self.out
+    }
+}
+
+/// Streaming reader of an estimates CSV: all nine columns required (any order, extra
+/// columns ignored, unit suffixes allowed as in [`super::columns`]); `t` finite; parameter
+/// fields empty, `NaN` (both `None`) or a number; rcond a number.
+pub struct EstimatesReader<R: Read> {
+    file: String,
+    csv: csv::Reader<R>,
+    header: Header,
+    cols: Vec<usize>,
+    rec: ByteRecord,
+}
+
+impl<R: Read> EstimatesReader<R> {
+    /// Read and check the header of `input` (`file` names it in messages).
+    pub fn new(file: &str, input: R) -> Result<Self, CsvError> {
+        let mut csv = csv_reader(input);
+        let mut rec = ByteRecord::new();
+        if !csv
+            .read_byte_record(&mut rec)
+            .map_err(|e| read_error(file, e))?
+        {
+            return Err(CsvError::file(
+                file,
+                format!(
+                    "the file is empty: expected the header {}",
+                    ESTIMATES_HEADER.join(",")
+                ),
+            ));
+        }
+        let header = Header::new(&rec, rec.position().map_or(1, |p| p.line()));
+        let cols = header.require(file, &ESTIMATES_HEADER)?;
+        Ok(Self {
+            file: file.to_owned(),
+            csv,
+            header,
+            cols,
+            rec,
+        })
+    }
+
+    /// The next row, or `None` at the end.
+    pub fn next_row(&mut self) -> Result<Option<EstimateRow>, CsvError> {
+        let f = self.file.as_str();
+        if !self
+            .csv
+            .read_byte_record(&mut self.rec)
+            .map_err(|e| read_error(f, e))?
+        {
+            return Ok(None);
+        }
+        let line = self.rec.position().map_or(0, |p| p.line());
+        check_length(f, &self.rec, line, &self.header)?;
+        let c = &self.cols;
+        let rec = &self.rec;
+        let opt = |i: usize| optional_field(f, rec, line, c[i], ESTIMATES_HEADER[i]);
+        Ok(Some(EstimateRow {
+            t: finite_field(f, rec, line, c[0], "t")?,
+            values: ParameterSet {
+                m_x: opt(1)?,
+                c_x: opt(2)?,
+                k_x: opt(3)?,
+                m_z: opt(4)?,
+                c_z: opt(5)?,
+                k_z: opt(6)?,
+            },
+            rcond_x: number_field(f, rec, line, c[7], "rcond_x")?,
+            rcond_z: number_field(f, rec, line, c[8], "rcond_z")?,
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_round_trip_with_missing_directions() {
+        let rows = [
+            EstimateRow {
+                t: 0.0,
+                values: ParameterSet::default(),
+                rcond_x: 0.0,
+                rcond_z: 0.0,
+            },
+            EstimateRow {
+                t: 1e-4,
+                values: ParameterSet {
+                    m_x: Some(14.29),
+                    c_x: Some(10.000_000_1),
+                    k_x: Some(1.195e6),
+                    ..Default::default()
+                },
+                rcond_x: 1.5e-3,
+                rcond_z: 2e-9,
+            },
+        ];
+        let mut w = EstimatesWriter::new(Vec::new()).unwrap();
+        for r in &rows {
+            w.write(r).unwrap();
+        }
+        let text = String::from_utf8(w.into_inner()).unwrap();
+        assert_eq!(
+            text,
+            "t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z\n0,,,,,,,0,0\n\
+             0.0001,14.29,10.0000001,1195000,,,,0.0015,2e-9\n"
+        );
+        let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
+        assert_eq!(r.next_row().unwrap(), Some(rows[0]));
+        assert_eq!(r.next_row().unwrap(), Some(rows[1]));
+        assert_eq!(r.next_row().unwrap(), None);
+    }
+
+    #[test]
+    fn nan_reads_as_missing_and_errors_are_located() {
+        let h = ESTIMATES_HEADER.join(",");
+        let text = format!("{h}\n0,NaN,1,2,3,4,5,0.1,0.2\n");
+        let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
+        let row = r.next_row().unwrap().unwrap();
+        assert_eq!(row.values.m_x, None);
+        assert_eq!(row.values.k_z, Some(5.0));
+        let text = format!("{h}\n0,1,x,2,3,4,5,0.1,0.2\n");
+        let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
+        assert!(r
+            .next_row()
+            .unwrap_err()
+            .to_string()
+            .starts_with("e.csv line 2, column 3 (c_x): c_x \"x\" is not a number"));
+        let e = EstimatesReader::new("e.csv", "t,m_x\n".as_bytes())
+            .err()
+            .unwrap();
+        assert!(e
+            .to_string()
+            .starts_with("e.csv line 1: the header lacks columns c_x, k_x"));
+    }
+}

@@ -1,0 +1,384 @@
+//! The response CSV: the rotor's measured or simulated vibration, one row per sample.
+//!
+//! ```text
+//! t,x,z,phi,phi_dot,phi_ddot
+//! s,m,m,rad,rad/s,rad/s^2          (units, not written: SI throughout)
+//! ```
+//!
+//! Written by `rotorid simulate` ([`ResponseWriter`]) with exactly that header, every value
+//! in shortest round-trip form (see [`super::number`]). Read by `rotorid identify` and
+//! `rotorid plot` ([`ResponseReader`], streaming), which
+//! accept more:
+//!
+//! - columns in any order, extra columns ignored (their content is not even parsed);
+//!   header names may carry a unit suffix (`x [m]`; see [`super::columns`]);
+//! - `t`, `x`, `z` required; `phi`, `phi_dot`, `phi_ddot` all three or none (partial is an
+//!   error naming the missing ones);
+//! - every used field a finite number; rows as long as the header;
+//! - time strictly increasing and uniformly sampled: with `dt = t_2 - t_1` (the first two
+//!   data rows), every later step must satisfy `|(t_i - t_(i-1)) - dt| <= tol * dt`,
+//!   `tol` = [`DEFAULT_TIME_TOLERANCE`] (1e-6) unless relaxed. A file written by
+//!   `simulate` (t_i = i dt exactly) passes with margin: its steps differ from dt by a few
+//!   ulps of t, e.g. 3e-14 s at t = 200 s, 3e-10 of dt = 0.1 ms.
+//!
+//! Errors name the file, the line (header = line 1) and the column (see
+//! [`super::csv_error`]).
+
+use std::io::{self, Read, Write};
+
+use csv::ByteRecord;
+use rotorid::SpeedState;
+
+use super::columns::{check_length, csv_reader, finite_field, read_error, Header};
+use super::csv_error::CsvError;
+use super::number::write_row;
+
+/// The header `simulate` writes.
+pub const RESPONSE_HEADER: [&str; 6] = ["t", "x", "z", "phi", "phi_dot", "phi_ddot"];
+
+/// Default relative tolerance on the sampling period (see the module doc).
+pub const DEFAULT_TIME_TOLERANCE: f64 = 1e-6;
+
+/// Writes the response CSV, one sample per row (see the module doc).
+pub struct ResponseWriter<W: Write> {
+    out: W,
+    scratch: Vec<u8>,
+}
+
+impl<W: Write> ResponseWriter<W> {
+    /// Write the header `t,x,z,phi,phi_dot,phi_ddot` to `out`.
+    pub fn new(mut out: W) -> io::Result<Self> {
+        writeln!(out, "{}", RESPONSE_HEADER.join(","))?;
+        Ok(Self {
+            out,
+            scratch: Vec::with_capacity(160),
+        })
+    }
+
+    /// One row: t [s], x [m], z [m], and phi [rad], w [rad/s], w' [rad/s^2] from `speed`.
+    pub fn write(&mut self, t: f64, x: f64, z: f64, speed: &SpeedState) -> io::Result<()> {
+        write_row(
+            &mut self.out,
+            &mut self.scratch,
+            &[
+                Some(t),
+                Some(x),
+                Some(z),
+                Some(speed.phi),
+                Some(speed.omega),
+                Some(speed.omega_dot),
+            ],
+        )
+    }
+
+    /// The underlying writer (not flushed).
+    pub fn into_inner(self) -> W {
+        self.out
+    }
+}
+
+/// One validated row of a response CSV.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ResponseRow {
+    /// 1-based line in the file.
+    pub line: u64,
+    /// Time t [s].
+    pub t: f64,
+    /// Horizontal displacement x [m].
+    pub x: f64,
+    /// Vertical displacement z [m].
+    pub z: f64,
+    /// phi [rad], w = phi_dot [rad/s], w' = phi_ddot [rad/s^2], when the file has them.
+    pub speed: Option<SpeedState>,
+}
+
+/// Streaming reader of a response CSV: validates each row as it is read and keeps O(1)
+/// state, so it reads a live pipe of any length (see the module doc for the rules).
+pub struct ResponseReader<R: Read> {
+    file: String,
+    csv: csv::Reader<R>,
+    header: Header,
+    txz: [usize; 3],
+    phi: Option<[usize; 3]>,
+    rec: ByteRecord,
+    tol: f64,
+    rows: u64,
+    first: Option<(f64, u64)>,
+    prev: Option<(f64, u64)>,
+    dt: Option<f64>,
+}
+
+impl<R: Read> ResponseReader<R> {
+    /// Read and check the header of `input`; `file` names it in messages; `time_tolerance`
+    /// is the relative tolerance on the sampling period (finite and >= 0).
+    pub fn new(file: &str, input: R, time_tolerance: f64) -> Result<Self, CsvError> {
+        if !(time_tolerance.is_finite() && time_tolerance >= 0.0) {
+            return Err(CsvError::file(
+                file,
+                format!(
+                    "time tolerance = {time_tolerance} is out of range: must be finite and >= 0"
+                ),
+            ));
+        }
+        let mut csv = csv_reader(input);
+        let mut rec = ByteRecord::new();
+        let found = csv
+            .read_byte_record(&mut rec)
+            .map_err(|e| read_error(file, e))?;
+        if !found {
+            return Err(CsvError::file(
+                file,
+                "the file is empty: expected a header line naming at least t,x,z, then one \
+                 row per sample",
+            ));
+        }
+        let line = rec.position().map_or(1, |p| p.line());
+        let header = Header::new(&rec, line);
+        let txz = header.require(file, &["t", "x", "z"])?;
+        let phis = [
+            header.find(file, "phi")?,
+            header.find(file, "phi_dot")?,
+            header.find(file, "phi_ddot")?,
+        ];
+        let phi = match phis {
+            [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+            [None, None, None] => None,
+            _ => {
+                let missing: Vec<&str> = ["phi", "phi_dot", "phi_ddot"]
+                    .iter()
+                    .zip(phis)
+                    .filter(|(_, p)| p.is_none())
+                    .map(|(n, _)| *n)
+                    .collect();
+                return Err(CsvError::line(
+                    file,
+                    line,
+                    format!(
+                        "the header has some but not all of phi, phi_dot, phi_ddot: missing {}; \
+                         give all three or none (then the scenario's speed profile is used)",
+                        missing.join(", ")
+                    ),
+                ));
+            }
+        };
+        Ok(Self {
+            file: file.to_owned(),
+            csv,
+            header,
+            txz: [txz[0], txz[1], txz[2]],
+            phi,
+            rec,
+            tol: time_tolerance,
+            rows: 0,
+            first: None,
+            prev: None,
+            dt: None,
+        })
+    }
+
+    /// True when the file has the phi, phi_dot, phi_ddot columns.
+    pub fn has_phi(&self) -> bool {
+        self.phi.is_some()
+    }
+
+    /// Data rows read so far.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// The sampling period dt = t_2 - t_1 [s], once two rows have been read.
+    pub fn dt(&self) -> Option<f64> {
+        self.dt
+    }
+
+    /// The next validated row, or `None` at the end of the input.
+    pub fn next_row(&mut self) -> Result<Option<ResponseRow>, CsvError> {
+        let f = self.file.as_str();
+        let found = self
+            .csv
+            .read_byte_record(&mut self.rec)
+            .map_err(|e| read_error(f, e))?;
+        if !found {
+            return Ok(None);
+        }
+        let line = self.rec.position().map_or(0, |p| p.line());
+        check_length(f, &self.rec, line, &self.header)?;
+        let field = |col: usize, name: &str| finite_field(f, &self.rec, line, col, name);
+        let [ct, cx, cz] = self.txz;
+        let t = field(ct, "t")?;
+        let x = field(cx, "x")?;
+        let z = field(cz, "z")?;
+        let speed = match self.phi {
+            Some([a, b, c]) => Some(SpeedState {
+                phi: field(a, "phi")?,
+                omega: field(b, "phi_dot")?,
+                omega_dot: field(c, "phi_ddot")?,
+            }),
+            None => None,
+        };
+        self.check_time(t, line)?;
+        self.rows += 1;
+        Ok(Some(ResponseRow {
+            line,
+            t,
+            x,
+            z,
+            speed,
+        }))
+    }
+
+    fn check_time(&mut self, t: f64, line: u64) -> Result<(), CsvError> {
+        let f = self.file.as_str();
+        let col = self.txz[0];
+        if let Some((tp, lp)) = self.prev {
+            let step = t - tp;
+            if step <= 0.0 {
+                return Err(CsvError::field(
+                    f,
+                    line,
+                    col,
+                    "t",
+                    format!(
+                        "time is not strictly increasing: t = {t} s follows t = {tp} s (line {lp})"
+                    ),
+                ));
+            }
+            match self.dt {
+                None => self.dt = Some(step),
+                Some(dt) => {
+                    if (step - dt).abs() > self.tol * dt {
+                        let (t1, l1) = self.first.expect("set with prev");
+                        return Err(CsvError::field(
+                            f,
+                            line,
+                            col,
+                            "t",
+                            format!(
+                                "sampling is not uniform: t = {t} s is {step:.9e} s after the \
+                                 previous sample (line {lp}), but dt = {dt:.9e} s (from t = \
+                                 {t1} s at line {l1} to the next row); the allowed deviation is \
+                                 {:e} of dt = {:.3e} s (relax it with --time-tolerance)",
+                                self.tol,
+                                self.tol * dt
+                            ),
+                        ));
+                    }
+                }
+            }
+        } else {
+            self.first = Some((t, line));
+        }
+        self.prev = Some((t, line));
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read_all(text: &str) -> Result<Vec<ResponseRow>, CsvError> {
+        let mut r = ResponseReader::new("d.csv", text.as_bytes(), DEFAULT_TIME_TOLERANCE)?;
+        let mut rows = Vec::new();
+        while let Some(row) = r.next_row()? {
+            rows.push(row);
+        }
+        Ok(rows)
+    }
+
+    fn err(text: &str) -> String {
+        read_all(text).expect_err("must be rejected").to_string()
+    }
+
+    #[test]
+    fn written_rows_read_back_identically() {
+        let mut w = ResponseWriter::new(Vec::new()).unwrap();
+        let s = SpeedState {
+            phi: 0.1,
+            omega: 125.66370614359172,
+            omega_dot: 0.0,
+        };
+        let dt = 1e-4;
+        let mut expect = Vec::new();
+        for i in 0..5u32 {
+            let t = f64::from(i) * dt;
+            let (x, z) = (1.234_567_890_123e-7 * f64::from(i), -3.3e-300);
+            w.write(t, x, z, &s).unwrap();
+            expect.push((t, x, z));
+        }
+        let text = String::from_utf8(w.into_inner()).unwrap();
+        assert!(text.starts_with("t,x,z,phi,phi_dot,phi_ddot\n0,0,-3.3e-300,0.1,"));
+        let rows = read_all(&text).unwrap();
+        assert_eq!(rows.len(), 5);
+        for (r, (t, x, z)) in rows.iter().zip(expect) {
+            assert_eq!((r.t, r.x, r.z), (t, x, z));
+            assert_eq!(r.speed, Some(s));
+        }
+        assert_eq!(rows[2].line, 4);
+    }
+
+    #[test]
+    fn any_order_units_and_extra_columns() {
+        let rows = read_all("note,Z [m],t (s),x\nabc,2,0,1\nzz,4,0.5,3\n,6,1,5\n").unwrap();
+        assert_eq!(rows.len(), 3);
+        assert_eq!((rows[1].t, rows[1].x, rows[1].z), (0.5, 3.0, 4.0));
+        assert!(rows[0].speed.is_none());
+    }
+
+    #[test]
+    fn header_problems_name_line_1() {
+        assert_eq!(
+            err(""),
+            "d.csv: the file is empty: expected a header line naming at least t,x,z, then one \
+             row per sample"
+        );
+        assert!(err("t,x\n0,1\n").starts_with("d.csv line 1: the header lacks column z;"));
+        assert!(err("time,x,y\n").starts_with("d.csv line 1: the header lacks columns t, z;"));
+        assert!(err("t,x,z,phi\n").starts_with(
+            "d.csv line 1: the header has some but not all of phi, phi_dot, phi_ddot: missing \
+             phi_dot, phi_ddot"
+        ));
+        assert!(err("t,x,z,x\n")
+            .starts_with("d.csv line 1, column 4 (x): column x appears twice (columns 2 and 4)"));
+    }
+
+    #[test]
+    fn bad_rows_name_line_and_column() {
+        let h = "t,x,z\n0,0,0\n0.1,0,0\n";
+        assert_eq!(
+            err(&format!("{h}0.2,abc,0\n")),
+            "d.csv line 4, column 2 (x): x \"abc\" is not a number: expected a number"
+        );
+        assert!(err(&format!("{h}0.2,0,nan\n"))
+            .starts_with("d.csv line 4, column 3 (z): z = NaN is not finite"));
+        assert!(err(&format!("{h}0.2,0,-inf\n"))
+            .starts_with("d.csv line 4, column 3 (z): z = -inf is not finite"));
+        assert_eq!(
+            err(&format!("{h}0.2,0\n")),
+            "d.csv line 4: short row: 2 fields where the header (line 1) has 3"
+        );
+        assert!(err(&format!("{h}0.2,0,0,9\n")).starts_with("d.csv line 4: long row"));
+        assert!(err(&format!("{h}0.1,0,0\n")).starts_with(
+            "d.csv line 4, column 1 (t): time is not strictly increasing: t = 0.1 s follows \
+             t = 0.1 s (line 3)"
+        ));
+        assert!(err(&format!("{h}0.3,0,0\n")).starts_with(
+            "d.csv line 4, column 1 (t): sampling is not uniform: t = 0.3 s is 2.000000000e-1 s after the previous sample \
+             (line 3), but dt = 1.000000000e-1 s (from t = 0 s at line 2 to the next row); the \
+             allowed deviation is 1e-6 of dt = 1.000e-7 s"
+        ));
+        assert!(err("t,x,z\n0,0,0\n-1,0,0\n").contains("line 3, column 1 (t): time is not"));
+    }
+
+    #[test]
+    fn tolerance_is_relative_to_dt() {
+        let text = "t,x,z\n0,0,0\n1,0,0\n2.0000009,0,0\n";
+        assert!(read_all(text).is_ok());
+        let text = "t,x,z\n0,0,0\n1,0,0\n2.0000011,0,0\n";
+        assert!(read_all(text).is_err());
+        let mut r = ResponseReader::new("d.csv", text.as_bytes(), 1e-5).unwrap();
+        while r.next_row().unwrap().is_some() {}
+        assert_eq!(r.rows(), 3);
+        assert_eq!(r.dt(), Some(1.0));
+    }
+}

@@ -1,0 +1,226 @@
+//! End-to-end tests of scenario files: the shipped examples work, and every kind of
+//! mistake (unknown key, missing key, wrong type, out-of-range value, bad TOML) is refused
+//! with a message naming the file, the line and the key, with a non-zero exit and no panic.
+
+use assert_cmd::Command;
+
+fn rotorid() -> Command {
+    Command::cargo_bin("rotorid").expect("the rotorid binary is built")
+}
+
+fn data(name: &str) -> String {
+    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn simulate(scenario: &str, extra: &[&str]) -> std::process::Output {
+    rotorid()
+        .args(["simulate", "--scenario", scenario, "--out", "-"])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+/// Write `text` as a scenario file, run simulate on it, and return stderr of the failure.
+fn refused(text: &str) -> (String, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.toml");
+    std::fs::write(&path, text).unwrap();
+    let p = path.to_str().unwrap().to_owned();
+    let out = simulate(&p, &[]);
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(!out.status.success(), "accepted:\n{text}");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(out.stdout.is_empty(), "wrote output for a bad scenario");
+    (p, err)
+}
+
+fn table1_text() -> String {
+    std::fs::read_to_string(data("table1.toml")).unwrap()
+}
+
+#[test]
+fn the_table1_file_is_the_builtin() {
+    let a = simulate("table1", &["--duration", "0.05"]);
+    let b = simulate(&data("table1.toml"), &["--duration", "0.05"]);
+    assert!(a.status.success() && b.status.success());
+    assert_eq!(a.stdout, b.stdout);
+}
+
+#[test]
+fn the_ramp_example_simulates_and_identifies() {
+    let sim = simulate(&data("table1_ramp.toml"), &[]);
+    assert!(
+        sim.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
+    let text = String::from_utf8(sim.stdout.clone()).unwrap();
+    assert_eq!(text.lines().count(), 1 + 3001);
+    let row1: Vec<f64> = text
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|f| f.parse().unwrap())
+        .collect();
+    assert_eq!(row1[1], 2e-7, "initial x from [initial]");
+    assert_eq!(row1[3], 30f64.to_radians(), "phi(0) from phi0_deg");
+    assert_eq!(row1[5], 10.0, "w' from accel");
+    let dir = tempfile::tempdir().unwrap();
+    let summary = dir.path().join("s.json");
+    let out = rotorid()
+        .args([
+            "identify",
+            "-",
+            "--scenario",
+            &data("table1_ramp.toml"),
+            "--out",
+            "/dev/null",
+            "-q",
+        ])
+        .args(["--summary", summary.to_str().unwrap()])
+        .write_stdin(sim.stdout)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    for p in ["m_x", "k_x", "m_z", "k_z"] {
+        let e = s["relative_error"][p].as_f64().unwrap();
+        assert!(
+            e.abs() < 1e-6,
+            "{p}: {e:e} (non-zero initial state must not matter)"
+        );
+    }
+}
+
+#[test]
+fn unknown_key() {
+    let (p, e) = refused(&table1_text().replace("kx = 1.195e6", "kxx = 1.195e6"));
+    assert!(e.contains(&format!("{p}:7: unknown key rotor.kxx; allowed keys in [rotor]: m, cx, cz, kx, kz, a, m_u, d, alpha_deg")), "{e}");
+    let (p, e) = refused(&(table1_text() + "\n[bearing]\nk = 1\n"));
+    assert!(
+        e.contains(&format!("{p}:28: unknown section or key `bearing`")),
+        "{e}"
+    );
+}
+
+#[test]
+fn missing_key_and_section() {
+    let (p, e) = refused(&table1_text().replace("kz = 1.195e6     # N/m\n", ""));
+    assert!(
+        e.contains(&format!(
+            "{p}: missing key rotor.kz (N/m) (section [rotor] at line 3); simulate needs it"
+        )),
+        "{e}"
+    );
+    let text = table1_text();
+    let no_speed = text[..text.find("[speed]").unwrap()].to_owned()
+        + &text[text.find("[sampling]").unwrap()..];
+    let (p, e) = refused(&no_speed);
+    assert!(e.contains(&format!("{p}: missing section [speed]")), "{e}");
+    let (p, e) = refused(&table1_text().replace("rpm = 1200.0     # rev/min\n", ""));
+    assert!(
+        e.contains(&format!(
+            "{p}:14: missing key speed.rpm (rev/min) for kind = \"constant\""
+        )),
+        "{e}"
+    );
+}
+
+#[test]
+fn wrong_type() {
+    let (p, e) = refused(&table1_text().replace("m = 14.29 ", "m = \"heavy\" "));
+    assert!(
+        e.contains(&format!(
+            "{p}:4: rotor.m = \"heavy\" has the wrong type: must be a number (kg)"
+        )),
+        "{e}"
+    );
+    let (p, e) = refused(&table1_text().replace("kind = \"constant\"", "kind = 1"));
+    assert!(
+        e.contains(&format!("{p}:15: speed.kind = 1 has the wrong type")),
+        "{e}"
+    );
+}
+
+#[test]
+fn out_of_range_value() {
+    let (p, e) = refused(&table1_text().replace("kx = 1.195e6", "kx = -1.195e6"));
+    assert!(
+        e.contains(&format!(
+            "{p}:7: rotor.kx = -1195000 is out of range: must be finite and > 0 (N/m)"
+        )),
+        "{e}"
+    );
+    let (p, e) = refused(&table1_text().replace("dt = 1.0e-4", "dt = 0.0"));
+    assert!(
+        e.contains(&format!(
+            "{p}:19: sampling.dt = 0 is out of range: must be finite and > 0 (s)"
+        )),
+        "{e}"
+    );
+    let (p, e) = refused(&table1_text().replace("m_u = 1.0e-4", "m_u = nan"));
+    assert!(
+        e.contains(&format!(
+            "{p}:10: rotor.m_u = NaN is out of range: must be finite and >= 0 (kg)"
+        )),
+        "{e}"
+    );
+    let (p, e) = refused(&table1_text().replace("rpm = 1200.0", "rpm = -5"));
+    assert!(
+        e.contains(&format!(
+            "{p}:16: speed.rpm = -5 is out of range: must be finite and >= 0 (rev/min)"
+        )),
+        "{e}"
+    );
+}
+
+#[test]
+fn invalid_toml_names_the_line() {
+    let (p, e) = refused(&table1_text().replace("cz = 10.0", "cz = = 10.0"));
+    assert!(e.contains(&format!("{p}:6: invalid TOML")), "{e}");
+}
+
+#[test]
+fn missing_file_is_a_clear_error() {
+    let out = simulate("/nonexistent/s.toml", &[]);
+    assert!(!out.status.success());
+    let e = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        e.contains("cannot read scenario file /nonexistent/s.toml"),
+        "{e}"
+    );
+}
+
+#[test]
+fn identify_accepts_a_scenario_with_only_the_known_quantities() {
+    let out = rotorid()
+        .args([
+            "identify",
+            "-",
+            "--scenario",
+            &data("known_only.toml"),
+            "--out",
+            "-",
+            "-q",
+        ])
+        .write_stdin("t,x,z\n0,0,0\n0.1,1e-7,2e-7\n0.2,3e-7,1e-7\n0.3,2e-7,-1e-7\n")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // ... but simulate needs the whole rotor.
+    let out = simulate(&data("known_only.toml"), &[]);
+    assert!(!out.status.success());
+    let e = String::from_utf8(out.stderr).unwrap();
+    assert!(e.contains("missing key rotor.m (kg)"), "{e}");
+}
