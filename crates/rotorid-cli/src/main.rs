@@ -7,6 +7,8 @@ use clap::{Parser, Subcommand};
 
 mod commands;
 mod io;
+mod plot;
+mod report;
 
 /// Identify the mass, damping and stiffness of a rotor-bearing system from its vibration.
 #[derive(Debug, Parser)]
