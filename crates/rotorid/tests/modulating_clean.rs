@@ -6,6 +6,7 @@ use rotorid::identify::modulating::{
     ModulatingError, ModulatingEstimate, ModulatingIdentifier, NoiseCompensation,
 };
 use rotorid::identify::{measurement, IdentifyError, Known};
+use rotorid::model::OutOfRange;
 use rotorid::simulate::{simulate, Method, TimeResponse};
 use rotorid::{InitialState, Sampling, Scenario};
 
@@ -310,9 +311,11 @@ fn bad_inputs_are_reported_with_their_values() {
         ),
     ] {
         match call(&r.t, &r.x, bad).unwrap_err() {
-            ModulatingError::Input(IdentifyError::OutOfRange {
-                field: f, allowed, ..
-            }) => {
+            ModulatingError::Input(IdentifyError::OutOfRange(OutOfRange {
+                field: f,
+                allowed,
+                ..
+            })) => {
                 assert_eq!(f, field);
                 assert!(!allowed.is_empty());
             }

@@ -9,7 +9,7 @@ use super::inputs::{Known, Measurement};
 use crate::model::SpeedState;
 use crate::simulate::TimeResponse;
 
-/// Identify over `measurements` (uniformly sampled every `dt` [s]): one estimate per
+/// Identify over `measurements` (uniformly sampled every `dt` \[s\]): one estimate per
 /// measurement. Stops at the first invalid measurement with its error.
 pub fn identify_batch(
     measurements: &[Measurement],
@@ -31,14 +31,34 @@ pub fn identify_response(
     known: Known,
     config: IdentifierConfig,
 ) -> Result<Vec<Estimate>, IdentifyError> {
+    let dt = record_dt(
+        &resp.t,
+        [
+            ("x", resp.x.len()),
+            ("z", resp.z.len()),
+            ("phi", resp.phi.len()),
+            ("phi_dot", resp.phi_dot.len()),
+            ("phi_ddot", resp.phi_ddot.len()),
+        ],
+    )?;
+    let mut id = AlgebraicIdentifier::new(known, dt, config)?;
     let n = resp.t.len();
-    let columns: [(&'static str, usize); 5] = [
-        ("x", resp.x.len()),
-        ("z", resp.z.len()),
-        ("phi", resp.phi.len()),
-        ("phi_dot", resp.phi_dot.len()),
-        ("phi_ddot", resp.phi_ddot.len()),
-    ];
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        out.push(id.push(&measurement(resp, i))?);
+    }
+    Ok(out)
+}
+
+/// The sampling period `t[1] - t[0]` \[s\] of a record with times `t` and the other
+/// `columns` (name, length), after checking that every column is as long as `t`
+/// ([`IdentifyError::ColumnLength`] for the first that is not) and that there are at least
+/// two samples ([`IdentifyError::TooFewSamples`]).
+pub(crate) fn record_dt(
+    t: &[f64],
+    columns: [(&'static str, usize); 5],
+) -> Result<f64, IdentifyError> {
+    let n = t.len();
     for (column, len) in columns {
         if len != n {
             return Err(IdentifyError::ColumnLength {
@@ -51,12 +71,7 @@ pub fn identify_response(
     if n < 2 {
         return Err(IdentifyError::TooFewSamples { samples: n });
     }
-    let mut id = AlgebraicIdentifier::new(known, resp.t[1] - resp.t[0], config)?;
-    let mut out = Vec::with_capacity(n);
-    for i in 0..n {
-        out.push(id.push(&measurement(resp, i))?);
-    }
-    Ok(out)
+    Ok(t[1] - t[0])
 }
 
 /// Sample `i` of `resp` as a [`Measurement`].

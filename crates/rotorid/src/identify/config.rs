@@ -4,8 +4,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::error::{check, IdentifyError};
+use super::error::IdentifyError;
 use super::quadrature::Quadrature;
+use crate::model::check;
 
 /// Default [`IdentifierConfig::rcond_min`]: instants whose scaled 3x3 system has a
 /// reciprocal condition number below this are flagged (ill-conditioned).
@@ -31,9 +32,9 @@ pub enum SpeedModel {
     /// Constant speed W: w = W, w' = 0 and phi = phi0 + W t (t the measurement's time);
     /// the measurements' speed fields are ignored (method.md section 4, constant case).
     Constant {
-        /// Speed W [rad/s], finite.
+        /// Speed W \[rad/s\], finite.
         omega: f64,
-        /// Rotor angle at t = 0 [rad], finite.
+        /// Rotor angle at t = 0 \[rad\], finite.
         phi0: f64,
     },
 }
@@ -75,8 +76,8 @@ impl IdentifierConfig {
         .validated()
     }
 
-    /// The default configuration for a rotor at constant speed `omega` [rad/s] from angle
-    /// `phi0` [rad] at t = 0.
+    /// The default configuration for a rotor at constant speed `omega` \[rad/s\] from angle
+    /// `phi0` \[rad\] at t = 0.
     pub fn constant_speed(omega: f64, phi0: f64) -> Result<Self, IdentifyError> {
         Self {
             speed_model: SpeedModel::Constant { omega, phi0 },

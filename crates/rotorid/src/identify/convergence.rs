@@ -40,8 +40,9 @@
 use serde::Serialize;
 
 use super::config::IdentifierConfig;
-use super::error::{check, IdentifyError};
+use super::error::IdentifyError;
 use super::estimate::Estimate;
+use crate::model::check;
 
 /// Default relative tolerance of the convergence band (1 %).
 pub const DEFAULT_TOLERANCE: f64 = 0.01;
@@ -52,17 +53,17 @@ pub const DEFAULT_STACK_CAPACITY: usize = 4096;
 /// One of the six identified parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 pub enum Parameter {
-    /// Mass from the x direction [kg].
+    /// Mass from the x direction \[kg\].
     Mx,
-    /// Damping cx [N s/m].
+    /// Damping cx \[N s/m\].
     Cx,
-    /// Stiffness kx [N/m].
+    /// Stiffness kx \[N/m\].
     Kx,
-    /// Mass from the z direction [kg].
+    /// Mass from the z direction \[kg\].
     Mz,
-    /// Damping cz [N s/m].
+    /// Damping cz \[N s/m\].
     Cz,
-    /// Stiffness kz [N/m].
+    /// Stiffness kz \[N/m\].
     Kz,
 }
 
@@ -101,10 +102,10 @@ pub struct ParameterConvergence {
     /// Value at the last well-conditioned instant (unit of the parameter); None if there
     /// was none.
     pub final_value: Option<f64>,
-    /// Time of that instant [s].
+    /// Time of that instant \[s\].
     pub final_t: Option<f64>,
     /// Earliest well-conditioned instant from which every well-conditioned estimate stays
-    /// within the tolerance of the final value [s]; None if there was no well-conditioned
+    /// within the tolerance of the final value \[s\]; None if there was no well-conditioned
     /// instant.
     pub identification_time: Option<f64>,
     /// Number of well-conditioned instants seen.
@@ -311,13 +312,7 @@ impl ConvergenceTracker {
         check("rcond_min", rcond_min, "finite and in [0, 1]", |v| {
             (0.0..=1.0).contains(&v)
         })?;
-        if capacity < 2 {
-            return Err(IdentifyError::OutOfRange {
-                field: "capacity",
-                value: capacity as f64,
-                allowed: ">= 2 (entries)",
-            });
-        }
+        check("capacity", capacity as f64, ">= 2 (entries)", |v| v >= 2.0)?;
         Ok(Self {
             tol,
             rcond_min,

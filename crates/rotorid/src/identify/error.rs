@@ -2,20 +2,15 @@
 //! its message states what is allowed, so a user can fix the input without reading code.
 //! A singular or ill-conditioned system is NOT an error (the estimate is NaN / flagged).
 
+use crate::model::OutOfRange;
+
 /// Why an identifier could not be built or could not take a measurement.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum IdentifyError {
-    /// A configuration value or known quantity is outside its allowed range (this includes
-    /// NaN and infinity).
-    #[error("{field} = {value} is out of range: must be {allowed}")]
-    OutOfRange {
-        /// The input's name (e.g. `dt`, `rcond_min`, `known.a`).
-        field: &'static str,
-        /// The rejected value.
-        value: f64,
-        /// The allowed range in words, with its unit.
-        allowed: &'static str,
-    },
+    /// A configuration value or known quantity (e.g. `dt`, `rcond_min`, `known.a`) is
+    /// outside its allowed range (this includes NaN and infinity).
+    #[error(transparent)]
+    OutOfRange(#[from] OutOfRange),
     /// A measurement holds NaN or infinity.
     #[error("sample {index}: {field} = {value} is not finite (the identifier needs finite measurements)")]
     NotFinite {
@@ -35,13 +30,13 @@ pub enum IdentifyError {
     NonUniformSampling {
         /// Index of the sample since the identifier started.
         index: u64,
-        /// Its time [s].
+        /// Its time \[s\].
         t: f64,
-        /// The previous sample's time plus dt [s].
+        /// The previous sample's time plus dt \[s\].
         expected: f64,
-        /// The allowed deviation from `expected` [s].
+        /// The allowed deviation from `expected` \[s\].
         tolerance: f64,
-        /// The nominal sampling period [s].
+        /// The nominal sampling period \[s\].
         dt: f64,
     },
     /// A record too short to derive the sampling period from.
@@ -68,22 +63,4 @@ pub enum IdentifyError {
         /// The name as given.
         name: String,
     },
-}
-
-/// Check `value` with `ok`, or return [`IdentifyError::OutOfRange`] naming `field`.
-pub(crate) fn check(
-    field: &'static str,
-    value: f64,
-    allowed: &'static str,
-    ok: impl Fn(f64) -> bool,
-) -> Result<f64, IdentifyError> {
-    if value.is_finite() && ok(value) {
-        Ok(value)
-    } else {
-        Err(IdentifyError::OutOfRange {
-            field,
-            value,
-            allowed,
-        })
-    }
 }

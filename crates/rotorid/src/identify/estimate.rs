@@ -6,11 +6,11 @@ use serde::{Deserialize, Serialize};
 /// The estimate for one direction (x or z) at one instant.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DirectionEstimate {
-    /// Mass m [kg] (NaN when the system is singular).
+    /// Mass m \[kg\] (NaN when the system is singular).
     pub m: f64,
-    /// Damping c [N s/m] (NaN when singular).
+    /// Damping c \[N s/m\] (NaN when singular).
     pub c: f64,
-    /// Stiffness k [N/m] (NaN when singular).
+    /// Stiffness k \[N/m\] (NaN when singular).
     pub k: f64,
     /// Reciprocal 1-norm condition number of the scaled 3x3 system, in [0, 1]
     /// (0 when singular); see [`super::system`] for its exact definition.
@@ -42,7 +42,7 @@ impl DirectionEstimate {
 /// Both directions' estimates at time t.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Estimate {
-    /// Time of the measurement the estimate is for [s].
+    /// Time of the measurement the estimate is for \[s\].
     pub t: f64,
     /// Horizontal direction: m, cx, kx.
     pub x: DirectionEstimate,

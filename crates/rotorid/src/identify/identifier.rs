@@ -53,13 +53,14 @@
 //! is compiled for AVX2 when the CPU has it, with bit-for-bit the same results.
 
 use super::config::{IdentifierConfig, SpeedModel};
-use super::error::{check, IdentifyError};
+use super::error::IdentifyError;
 use super::estimate::{DirectionEstimate, Estimate};
 use super::inputs::{Known, Measurement};
 use super::lanes::F2;
 use super::quadrature::RunningIntegrals;
 use super::system::{recip_pow2, solve3};
 use super::trig::sin_cos;
+use crate::model::check;
 
 /// Number of integrated signals: (y, tau y, tau^2 y, u, v) for y = x, z, interleaved
 /// (x then z for each) so that the two directions sit in adjacent lanes, and two zeros
@@ -85,7 +86,7 @@ pub struct AlgebraicIdentifier {
     integrals: RunningIntegrals<NS>,
     /// Samples accepted since the start (or the last reset).
     n: u64,
-    /// Time of the last accepted sample [s].
+    /// Time of the last accepted sample \[s\].
     t_prev: f64,
     /// The CPU has AVX2: run the hot path compiled for it (same results, bit for bit:
     /// no FMA contraction, only wider vectors).
@@ -93,7 +94,7 @@ pub struct AlgebraicIdentifier {
 }
 
 impl AlgebraicIdentifier {
-    /// An identifier for data sampled every `dt` [s] (finite, > 0), with the known
+    /// An identifier for data sampled every `dt` \[s\] (finite, > 0), with the known
     /// quantities `known` (finite) and `config` (validated here).
     pub fn new(known: Known, dt: f64, config: IdentifierConfig) -> Result<Self, IdentifyError> {
         let known = known.validated()?;
@@ -115,7 +116,7 @@ impl AlgebraicIdentifier {
         self.known
     }
 
-    /// The nominal sampling period [s].
+    /// The nominal sampling period \[s\].
     pub fn dt(&self) -> f64 {
         self.dt
     }
@@ -206,19 +207,7 @@ impl AlgebraicIdentifier {
             return Err(self.not_finite(m, general));
         }
         if self.n > 0 {
-            let expected = self.t_prev + self.dt;
-            let tolerance = SAMPLING_TOLERANCE * self.dt
-                + 8.0 * f64::EPSILON * m.t.abs().max(self.t_prev.abs());
-            let on_time = (m.t - expected).abs() <= tolerance;
-            if !on_time {
-                return Err(IdentifyError::NonUniformSampling {
-                    index: self.n,
-                    t: m.t,
-                    expected,
-                    tolerance,
-                    dt: self.dt,
-                });
-            }
+            check_on_time(self.n, m.t, self.t_prev, self.dt)?;
         }
         Ok(())
     }
@@ -244,6 +233,26 @@ impl AlgebraicIdentifier {
             field,
             value,
         }
+    }
+}
+
+/// Check that sample `index` at time `t` \[s\] is the previous one at `t_prev` \[s\] plus `dt`
+/// \[s\] within `SAMPLING_TOLERANCE dt + 8 ulp(max(|t|, |t_prev|))`, else
+/// [`IdentifyError::NonUniformSampling`] (a NaN `t` is rejected too).
+#[inline(always)]
+pub(crate) fn check_on_time(index: u64, t: f64, t_prev: f64, dt: f64) -> Result<(), IdentifyError> {
+    let expected = t_prev + dt;
+    let tolerance = SAMPLING_TOLERANCE * dt + 8.0 * f64::EPSILON * t.abs().max(t_prev.abs());
+    if (t - expected).abs() <= tolerance {
+        Ok(())
+    } else {
+        Err(IdentifyError::NonUniformSampling {
+            index,
+            t,
+            expected,
+            tolerance,
+            dt,
+        })
     }
 }
 

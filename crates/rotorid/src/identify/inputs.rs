@@ -3,18 +3,18 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::error::{check, IdentifyError};
-use crate::model::{Rotor, SpeedState};
+use super::error::IdentifyError;
+use crate::model::{check, Rotor, SpeedState};
 
 /// The quantities the identifiers take as known (method.md section 4).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Known {
-    /// Gyroscopic coefficient a [N s^2/m], any finite value.
+    /// Gyroscopic coefficient a \[N s^2/m\], any finite value.
     pub a: f64,
-    /// Unbalance m_u d [kg m], any finite value (a negative value is the same unbalance
+    /// Unbalance m_u d \[kg m\], any finite value (a negative value is the same unbalance
     /// at alpha + pi).
     pub mud: f64,
-    /// Angular position of the unbalance alpha [rad], finite.
+    /// Angular position of the unbalance alpha \[rad\], finite.
     pub alpha: f64,
 }
 
@@ -41,13 +41,13 @@ impl Known {
 /// One sample of the measured signals.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Measurement {
-    /// Time t [s]; uniformly spaced by the identifier's dt.
+    /// Time t \[s\]; uniformly spaced by the identifier's dt.
     pub t: f64,
-    /// Horizontal displacement x [m].
+    /// Horizontal displacement x \[m\].
     pub x: f64,
-    /// Vertical displacement z [m].
+    /// Vertical displacement z \[m\].
     pub z: f64,
-    /// Rotor angle phi [rad], speed w = phi' [rad/s] and acceleration w' = phi'' [rad/s^2]
+    /// Rotor angle phi \[rad\], speed w = phi' \[rad/s\] and acceleration w' = phi'' \[rad/s^2\]
     /// at t (ignored, and not validated, by the constant-speed identifier).
     pub speed: SpeedState,
 }

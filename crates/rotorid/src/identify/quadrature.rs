@@ -41,6 +41,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use super::error::IdentifyError;
+use crate::model::check;
 
 /// Number of iterated-integral levels kept by [`RunningIntegrals`] (I1 to I4).
 pub const LEVELS: usize = 4;
@@ -361,15 +362,9 @@ pub struct RunningIntegrals<const NS: usize> {
 }
 
 impl<const NS: usize> RunningIntegrals<NS> {
-    /// Integrals of signals sampled every `h` [s] (finite, > 0) with `quadrature`.
+    /// Integrals of signals sampled every `h` \[s\] (finite, > 0) with `quadrature`.
     pub fn new(quadrature: Quadrature, h: f64) -> Result<Self, IdentifyError> {
-        if !(h.is_finite() && h > 0.0) {
-            return Err(IdentifyError::OutOfRange {
-                field: "dt",
-                value: h,
-                allowed: "finite and > 0 (s)",
-            });
-        }
+        check("dt", h, "finite and > 0 (s)", |v| v > 0.0)?;
         let beta = quadrature.weights();
         let engine = match quadrature {
             Quadrature::Trapezoid => Engine::Q2(Cascade::new(beta, h)),
@@ -389,7 +384,7 @@ impl<const NS: usize> RunningIntegrals<NS> {
         self.quadrature
     }
 
-    /// The step h [s].
+    /// The step h \[s\].
     pub fn h(&self) -> f64 {
         self.h
     }

@@ -33,14 +33,14 @@ use super::lanes::F2;
 /// The solution of one scaled 3x3 system.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScaledSolution {
-    /// theta = (m [kg], c [N s/m], k [N/m]); NaN when the system is singular.
+    /// theta = (m \[kg\], c \[N s/m\], k \[N/m\]); NaN when the system is singular.
     pub theta: Vector3<f64>,
     /// Reciprocal 1-norm condition number of the scaled matrix (module docs), in [0, 1];
     /// 0 when singular.
     pub rcond: f64,
 }
 
-/// Solve `a theta = b` at `tau` = t - t_0 [s] (finite, > 0; anything else gives the
+/// Solve `a theta = b` at `tau` = t - t_0 \[s\] (finite, > 0; anything else gives the
 /// singular answer) with the scaling of the module docs.
 pub fn solve_scaled(a: &Matrix3<f64>, b: &Vector3<f64>, tau: f64) -> ScaledSolution {
     if !(tau > 0.0 && tau.is_finite()) {

@@ -23,7 +23,8 @@ mod rotor;
 mod scenario;
 mod speed;
 
-pub use error::ModelError;
+pub(crate) use error::check;
+pub use error::{ModelError, OutOfRange};
 pub use rotor::{unbalance_force_from, Rotor, RotorParams, Unbalance};
 pub use scenario::{InitialState, Sampling, Scenario};
 pub use speed::{SpeedProfile, SpeedState};

@@ -9,16 +9,16 @@ use super::speed::SpeedState;
 /// Unbalance: a mass `m_u` at radius `d` and angular position `alpha` on the disk.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Unbalance {
-    /// Unbalance mass m_u [kg], >= 0.
+    /// Unbalance mass m_u \[kg\], >= 0.
     pub m_u: f64,
-    /// Radius of the unbalance mass d [m], >= 0.
+    /// Radius of the unbalance mass d \[m\], >= 0.
     pub d: f64,
-    /// Angular position alpha [rad] of the unbalance relative to phi = 0.
+    /// Angular position alpha \[rad\] of the unbalance relative to phi = 0.
     pub alpha: f64,
 }
 
 impl Unbalance {
-    /// m_u * d [kg m], the only combination of m_u and d the dynamics see.
+    /// m_u * d \[kg m\], the only combination of m_u and d the dynamics see.
     pub fn mud(&self) -> f64 {
         self.m_u * self.d
     }
@@ -28,17 +28,17 @@ impl Unbalance {
 /// with [`Rotor::new`], which checks every field.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RotorParams {
-    /// Modal mass of the disk m [kg], > 0 (common to both directions).
+    /// Modal mass of the disk m \[kg\], > 0 (common to both directions).
     pub m: f64,
-    /// Support damping in x, cx [N s/m], >= 0.
+    /// Support damping in x, cx \[N s/m\], >= 0.
     pub cx: f64,
-    /// Support damping in z, cz [N s/m], >= 0.
+    /// Support damping in z, cz \[N s/m\], >= 0.
     pub cz: f64,
-    /// Support stiffness in x, kx [N/m], > 0.
+    /// Support stiffness in x, kx \[N/m\], > 0.
     pub kx: f64,
-    /// Support stiffness in z, kz [N/m], > 0.
+    /// Support stiffness in z, kz \[N/m\], > 0.
     pub kz: f64,
-    /// Gyroscopic coefficient a [N s^2/m] (= kg), any finite value.
+    /// Gyroscopic coefficient a \[N s^2/m\] (= kg), any finite value.
     pub a: f64,
     /// The unbalance that drives the rotor.
     pub unbalance: Unbalance,
@@ -90,27 +90,27 @@ impl Rotor {
     pub fn params(&self) -> RotorParams {
         self.p
     }
-    /// m [kg].
+    /// m \[kg\].
     pub fn m(&self) -> f64 {
         self.p.m
     }
-    /// cx [N s/m].
+    /// cx \[N s/m\].
     pub fn cx(&self) -> f64 {
         self.p.cx
     }
-    /// cz [N s/m].
+    /// cz \[N s/m\].
     pub fn cz(&self) -> f64 {
         self.p.cz
     }
-    /// kx [N/m].
+    /// kx \[N/m\].
     pub fn kx(&self) -> f64 {
         self.p.kx
     }
-    /// kz [N/m].
+    /// kz \[N/m\].
     pub fn kz(&self) -> f64 {
         self.p.kz
     }
-    /// Gyroscopic coefficient a [N s^2/m].
+    /// Gyroscopic coefficient a \[N s^2/m\].
     pub fn a(&self) -> f64 {
         self.p.a
     }
@@ -119,23 +119,23 @@ impl Rotor {
         self.p.unbalance
     }
 
-    /// M = m I [kg].
+    /// M = m I \[kg\].
     pub fn mass_matrix(&self) -> Matrix2<f64> {
         Matrix2::identity() * self.p.m
     }
 
-    /// C(w) = diag(cx, cz) + w [[0, -a], [a, 0]] [N s/m], w in rad/s.
+    /// C(w) = diag(cx, cz) + w [[0, -a], [a, 0]] \[N s/m\], w in rad/s.
     pub fn damping_matrix(&self, w: f64) -> Matrix2<f64> {
         let aw = self.p.a * w;
         Matrix2::new(self.p.cx, -aw, aw, self.p.cz)
     }
 
-    /// K(w') = diag(kx, kz) + w' [[0, -a], [0, 0]] [N/m], w' in rad/s^2.
+    /// K(w') = diag(kx, kz) + w' [[0, -a], [0, 0]] \[N/m\], w' in rad/s^2.
     pub fn stiffness_matrix(&self, w_dot: f64) -> Matrix2<f64> {
         Matrix2::new(self.p.kx, -self.p.a * w_dot, 0.0, self.p.kz)
     }
 
-    /// Unbalance force F [N] at the rotor state `s`:
+    /// Unbalance force F \[N\] at the rotor state `s`:
     /// `m_u d (w^2 sin(phi+alpha) - w' cos(phi+alpha), w' sin(phi+alpha) + w^2 cos(phi+alpha))`.
     pub fn unbalance_force(&self, s: &SpeedState) -> Vector2<f64> {
         let u = self.p.unbalance;

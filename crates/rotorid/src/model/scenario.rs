@@ -10,7 +10,7 @@ use super::speed::SpeedProfile;
 /// The most samples a scenario may ask for (1e9), to fail fast instead of exhausting memory.
 pub const MAX_SAMPLES: f64 = 1.0e9;
 
-/// Uniform sampling: period `dt` [s] over `duration` [s].
+/// Uniform sampling: period `dt` \[s\] over `duration` \[s\].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Sampling {
     dt: f64,
@@ -18,7 +18,7 @@ pub struct Sampling {
 }
 
 impl Sampling {
-    /// `dt` finite and > 0, `duration` finite and >= dt, at most [`MAX_SAMPLES`] samples.
+    /// `dt` finite and > 0, `duration` finite and >= dt, at most `MAX_SAMPLES` (1e9) samples.
     pub fn new(dt: f64, duration: f64) -> Result<Self, ModelError> {
         check("dt", dt, "finite and > 0 (s)", |v| v > 0.0)?;
         check("duration", duration, "finite and > 0 (s)", |v| v > 0.0)?;
@@ -35,11 +35,11 @@ impl Sampling {
         }
         Ok(Self { dt, duration })
     }
-    /// Sampling period [s].
+    /// Sampling period \[s\].
     pub fn dt(&self) -> f64 {
         self.dt
     }
-    /// Record length [s].
+    /// Record length \[s\].
     pub fn duration(&self) -> f64 {
         self.duration
     }
@@ -52,23 +52,23 @@ impl Sampling {
     pub fn samples(&self) -> usize {
         self.steps() + 1
     }
-    /// Time of sample `i` [s]: exactly `i as f64 * dt`.
+    /// Time of sample `i` \[s\]: exactly `i as f64 * dt`.
     #[inline]
     pub fn time(&self, i: usize) -> f64 {
         i as f64 * self.dt
     }
 }
 
-/// Initial displacement [m] and velocity [m/s] of the disk.
+/// Initial displacement \[m\] and velocity \[m/s\] of the disk.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct InitialState {
-    /// x(0) [m].
+    /// x(0) \[m\].
     pub x: f64,
-    /// z(0) [m].
+    /// z(0) \[m\].
     pub z: f64,
-    /// x'(0) [m/s].
+    /// x'(0) \[m/s\].
     pub vx: f64,
-    /// z'(0) [m/s].
+    /// z'(0) \[m/s\].
     pub vz: f64,
 }
 

@@ -1,5 +1,5 @@
-//! Speed profiles: the rotor angle phi(t) [rad], speed w = phi' [rad/s] and angular
-//! acceleration w' = phi'' [rad/s^2] at any time t [s].
+//! Speed profiles: the rotor angle phi(t) \[rad\], speed w = phi' \[rad/s\] and angular
+//! acceleration w' = phi'' \[rad/s^2\] at any time t \[s\].
 //!
 //! ```text
 //! constant:  phi = phi0 + W t,                w = W,           w' = 0
@@ -14,37 +14,37 @@ use super::rpm_to_rad_per_s;
 /// Rotor angle, speed and angular acceleration at one instant.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct SpeedState {
-    /// Rotor angle phi [rad].
+    /// Rotor angle phi \[rad\].
     pub phi: f64,
-    /// Speed w = phi' [rad/s].
+    /// Speed w = phi' \[rad/s\].
     pub omega: f64,
-    /// Angular acceleration w' = phi'' [rad/s^2].
+    /// Angular acceleration w' = phi'' \[rad/s^2\].
     pub omega_dot: f64,
 }
 
 /// How the rotor speed varies with time.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub enum SpeedProfile {
-    /// Constant speed W [rad/s] from angle phi0 [rad].
+    /// Constant speed W \[rad/s\] from angle phi0 \[rad\].
     Constant {
-        /// W [rad/s].
+        /// W \[rad/s\].
         omega: f64,
-        /// phi(0) [rad].
+        /// phi(0) \[rad\].
         phi0: f64,
     },
     /// Linear ramp: w(t) = omega0 + accel t, from angle phi0.
     Ramp {
-        /// w(0) [rad/s].
+        /// w(0) \[rad/s\].
         omega0: f64,
-        /// w' [rad/s^2], constant.
+        /// w' \[rad/s^2\], constant.
         accel: f64,
-        /// phi(0) [rad].
+        /// phi(0) \[rad\].
         phi0: f64,
     },
 }
 
 impl SpeedProfile {
-    /// Constant speed `rpm` [rev/min] (finite, >= 0) from angle `phi0` [rad].
+    /// Constant speed `rpm` \[rev/min\] (finite, >= 0) from angle `phi0` \[rad\].
     pub fn constant_rpm(rpm: f64, phi0: f64) -> Result<Self, ModelError> {
         check("rpm", rpm, "finite and >= 0 (rev/min)", |v| v >= 0.0)?;
         check("phi0", phi0, "finite (rad)", |_| true)?;
@@ -54,8 +54,8 @@ impl SpeedProfile {
         })
     }
 
-    /// Linear ramp from `rpm0` [rev/min] (finite, >= 0) with angular acceleration `accel`
-    /// [rad/s^2] (finite; negative for a run-down) from angle `phi0` [rad].
+    /// Linear ramp from `rpm0` \[rev/min\] (finite, >= 0) with angular acceleration `accel`
+    /// \[rad/s^2\] (finite; negative for a run-down) from angle `phi0` \[rad\].
     pub fn ramp(rpm0: f64, accel: f64, phi0: f64) -> Result<Self, ModelError> {
         check("rpm0", rpm0, "finite and >= 0 (rev/min)", |v| v >= 0.0)?;
         check("accel", accel, "finite (rad/s^2)", |_| true)?;
@@ -67,7 +67,7 @@ impl SpeedProfile {
         })
     }
 
-    /// phi, w, w' at time `t` [s].
+    /// phi, w, w' at time `t` \[s\].
     #[inline]
     pub fn at(&self, t: f64) -> SpeedState {
         match *self {

@@ -10,10 +10,10 @@
 //! method.md section 7 defines the noise by the signal-to-noise ratio of each channel:
 //! sigma = RMS(clean channel) * 10^(-SNR/20), RMS over all samples of the record.
 
-use crate::model::{InitialState, RotorParams, Scenario};
+use crate::model::{check, InitialState, RotorParams, Scenario};
 
 use super::discretisation::{Discrete, Integrator};
-use super::error::{check, RefineError};
+use super::error::RefineError;
 use super::fisher::Fisher;
 use super::record::Experiment;
 use super::result::{identifiability_warnings, rows, Bound, Crb};

@@ -3,22 +3,16 @@
 //! set is *not* an error: it is reported in the result (flag, warnings, infinite standard
 //! errors).
 
-use crate::model::ModelError;
+use crate::model::{ModelError, OutOfRange};
 
-/// An input to [`refine`](super::refine), [`crb`](super::crb) or
+/// An input to [`refine`](super::refine), [`crb`](super::crb()) or
 /// [`model_response`](super::model_response) that cannot be used.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RefineError {
-    /// A scalar input is outside its allowed range (this includes NaN and infinity).
-    #[error("{field} = {value} is out of range: must be {allowed}")]
-    OutOfRange {
-        /// The input's name (e.g. `dt`, `m`, `sigma_x`).
-        field: &'static str,
-        /// The rejected value.
-        value: f64,
-        /// The allowed range in words, with its unit.
-        allowed: &'static str,
-    },
+    /// A scalar input (e.g. `dt`, `m`, `sigma_x`) is outside its allowed range (this
+    /// includes NaN and infinity).
+    #[error(transparent)]
+    OutOfRange(#[from] OutOfRange),
     /// A per-sample array does not have as many samples as the record.
     #[error("{field} has {len} samples but the record has {expected}: every per-sample array must have the same length")]
     LengthMismatch {
@@ -59,24 +53,6 @@ pub enum RefineError {
     /// The model description is invalid.
     #[error(transparent)]
     Model(#[from] ModelError),
-}
-
-/// Check `value` with `ok`, or return [`RefineError::OutOfRange`] naming `field`.
-pub(crate) fn check(
-    field: &'static str,
-    value: f64,
-    allowed: &'static str,
-    ok: impl Fn(f64) -> bool,
-) -> Result<f64, RefineError> {
-    if value.is_finite() && ok(value) {
-        Ok(value)
-    } else {
-        Err(RefineError::OutOfRange {
-            field,
-            value,
-            allowed,
-        })
-    }
 }
 
 /// First non-finite entry of `v`, as [`RefineError::NonFinite`].

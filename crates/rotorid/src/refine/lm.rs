@@ -38,10 +38,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::model::{InitialState, RotorParams};
+use crate::model::{check, InitialState, RotorParams};
 
 use super::discretisation::{Discrete, Integrator};
-use super::error::{check, RefineError};
+use super::error::RefineError;
 use super::fisher::Fisher;
 use super::record::Record;
 use super::result::{identifiability_warnings, rows, Estimate, Refined, Warning, STD_ERROR_BASIS};

@@ -13,7 +13,7 @@
 //! the likelihood over the unknowns (default m, cx, kx, cz, kz, plus the unknown initial
 //! state as four nuisance parameters; optionally a and the unbalance), by Gauss-Newton
 //! with Levenberg-Marquardt damping on the exact sensitivities of the discrete model.
-//! Standard errors come from the Fisher information at the estimate; [`crb`] gives the
+//! Standard errors come from the Fisher information at the estimate; [`crb()`] gives the
 //! Cramer-Rao bound at the truth (method.md section 7).
 //!
 //! The model must be far more accurate than the noise (the relative bound on m is ~4e-5

@@ -6,10 +6,10 @@
 //! phi'' = w' at both ends (exact for any polynomial phi(t) of degree <= 5, so exact for
 //! constant speed and linear ramps); w and w' are its first and second derivatives.
 
-use crate::model::{Scenario, SpeedProfile};
+use crate::model::{check, Scenario, SpeedProfile};
 use crate::simulate::TimeResponse;
 
-use super::error::{check, check_finite, RefineError};
+use super::error::{check_finite, RefineError};
 
 /// The rotor angle, speed and acceleration during a record.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -227,7 +227,7 @@ pub struct Bound {
     pub relative: Option<f64>,
 }
 
-/// The Cramer-Rao bound of an experiment (see [`crb`](super::crb)).
+/// The Cramer-Rao bound of an experiment (see [`crb`](super::crb())).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Crb {
     /// Bounds on the model parameters (order as in [`Refined::parameters`]).

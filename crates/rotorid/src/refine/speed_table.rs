@@ -28,13 +28,13 @@ pub(crate) struct ForcePoint {
     pub w: f64,
     /// w' \[rad/s^2\].
     pub wd: f64,
-    /// g_xc = w^2 sin phi - w' cos phi [1/s^2].
+    /// g_xc = w^2 sin phi - w' cos phi \[1/s^2\].
     pub gxc: f64,
-    /// g_xs = w^2 cos phi + w' sin phi [1/s^2].
+    /// g_xs = w^2 cos phi + w' sin phi \[1/s^2\].
     pub gxs: f64,
-    /// g_zc = w' sin phi + w^2 cos phi [1/s^2].
+    /// g_zc = w' sin phi + w^2 cos phi \[1/s^2\].
     pub gzc: f64,
-    /// g_zs = w' cos phi - w^2 sin phi [1/s^2].
+    /// g_zs = w' cos phi - w^2 sin phi \[1/s^2\].
     pub gzs: f64,
 }
 
@@ -54,7 +54,7 @@ impl ForcePoint {
 }
 
 /// Quintic Hermite interpolation of phi on one interval of length `h` \[s\] at fraction
-/// `u` in [0, 1]: returns (phi, phi', phi'') [rad, rad/s, rad/s^2].
+/// `u` in [0, 1]: returns (phi, phi', phi'') \[rad, rad/s, rad/s^2\].
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn hermite5(
     p0: f64,

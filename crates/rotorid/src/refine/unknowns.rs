@@ -204,7 +204,7 @@ pub(crate) struct Theta {
     pub a: f64,
     pub uc: f64,
     pub us: f64,
-    /// (x0, z0, vx0, vz0) [m, m, m/s, m/s].
+    /// (x0, z0, vx0, vz0) \[m, m, m/s, m/s\].
     pub y0: [f64; 4],
 }
 
@@ -306,7 +306,7 @@ impl Theta {
 /// Check that every parameter is finite and m > 0 (c and k may be anything finite: a
 /// starting point or an intermediate iterate need not be physical).
 pub(crate) fn check_params(p: &RotorParams) -> Result<(), super::error::RefineError> {
-    use super::error::check;
+    use crate::model::check;
     check("m", p.m, "finite and > 0 (kg)", |v| v > 0.0)?;
     check("cx", p.cx, "finite (N s/m)", |_| true)?;
     check("kx", p.kx, "finite (N/m)", |_| true)?;

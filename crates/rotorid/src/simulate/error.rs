@@ -2,7 +2,7 @@
 //! value or instant, and its message states what is allowed, so a user can fix the input
 //! without reading code.
 
-use crate::model::ModelError;
+use crate::model::{check, ModelError, OutOfRange};
 
 /// Why a simulation (or adding noise to one) could not be done.
 #[derive(Debug, thiserror::Error)]
@@ -10,25 +10,19 @@ pub enum SimulateError {
     /// A model input (rotor, speed profile, initial state) is invalid.
     #[error(transparent)]
     Model(#[from] ModelError),
-    /// A simulation input is outside its allowed range (this includes NaN and infinity).
-    #[error("{field} = {value} is out of range: must be {allowed}")]
-    OutOfRange {
-        /// The input's name (e.g. `dt`, `snr_db`, `tolerance`).
-        field: &'static str,
-        /// The rejected value.
-        value: f64,
-        /// The allowed range in words, with its unit.
-        allowed: &'static str,
-    },
+    /// A simulation input (e.g. `dt`, `snr_db`, `tolerance`) is outside its allowed range
+    /// (this includes NaN and infinity).
+    #[error(transparent)]
+    OutOfRange(#[from] OutOfRange),
     /// The DoPri8 reference integrator (russell_ode) reported a failure on one sampling
     /// interval.
     #[error(
         "the DoPri8 reference integration failed between t = {t0} s and t = {t1} s: {message}"
     )]
     Integration {
-        /// Start of the failed interval [s].
+        /// Start of the failed interval \[s\].
         t0: f64,
-        /// End of the failed interval [s].
+        /// End of the failed interval \[s\].
         t1: f64,
         /// The solver's message.
         message: &'static str,
@@ -36,7 +30,7 @@ pub enum SimulateError {
     /// The computed state stopped being finite (overflow: inputs of absurd magnitude).
     #[error("the response became non-finite at t = {t} s (overflow; check the magnitudes of the rotor parameters, speed and initial state)")]
     NonFinite {
-        /// Time of the first non-finite sample [s].
+        /// Time of the first non-finite sample \[s\].
         t: f64,
     },
     /// A channel that noise is to be added to has no samples.
@@ -59,24 +53,6 @@ pub enum SimulateError {
         /// The name as given.
         name: String,
     },
-}
-
-/// Check `value` with `ok`, or return [`SimulateError::OutOfRange`] naming `field`.
-pub(crate) fn check(
-    field: &'static str,
-    value: f64,
-    allowed: &'static str,
-    ok: impl Fn(f64) -> bool,
-) -> Result<f64, SimulateError> {
-    if value.is_finite() && ok(value) {
-        Ok(value)
-    } else {
-        Err(SimulateError::OutOfRange {
-            field,
-            value,
-            allowed,
-        })
-    }
 }
 
 /// Validate a speed profile whose fields may have been set directly (they are public):
@@ -103,5 +79,5 @@ pub(crate) fn check_speed(speed: &crate::model::SpeedProfile) -> Result<(), Simu
 
 /// Validate a sampling period: finite and > 0 (s).
 pub(crate) fn check_dt(dt: f64) -> Result<f64, SimulateError> {
-    check("dt", dt, "finite and > 0 (s)", |v| v > 0.0)
+    Ok(check("dt", dt, "finite and > 0 (s)", |v| v > 0.0)?)
 }

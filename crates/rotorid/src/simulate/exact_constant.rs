@@ -37,7 +37,7 @@ use nalgebra::{Matrix4, Matrix6, Vector4};
 
 use super::error::{check_dt, check_speed, SimulateError};
 use super::{finite, Integrator, Sample};
-use crate::model::{InitialState, Rotor, SpeedProfile, SpeedState};
+use crate::model::{check, InitialState, Rotor, SpeedProfile, SpeedState};
 
 /// Exact discretisation of eq. (1) at constant speed (matrix exponential of the system
 /// augmented with the forcing oscillator).
@@ -48,27 +48,25 @@ pub struct ExactConstant {
     dt: f64,
     n: u64,
     state: SpeedState,
-    /// (x, z, vx, vz) [m, m, m/s, m/s].
+    /// (x, z, vx, vz) \[m, m, m/s, m/s\].
     y: Vector4<f64>,
     phi44: Matrix4<f64>,
     phi4s: Vector4<f64>,
     phi4c: Vector4<f64>,
 }
 
-/// The constant speed W [rad/s] of `speed`, or an error if it accelerates.
+/// The constant speed W \[rad/s\] of `speed`, or an error if it accelerates.
 fn constant_omega(speed: &SpeedProfile) -> Result<f64, SimulateError> {
     match *speed {
         SpeedProfile::Constant { omega, .. } => Ok(omega),
         SpeedProfile::Ramp { omega0, accel, .. } => {
-            if accel == 0.0 {
-                Ok(omega0)
-            } else {
-                Err(SimulateError::OutOfRange {
-                    field: "accel",
-                    value: accel,
-                    allowed: "0 for the exact constant-speed discretisation (rad/s^2); use the DoPri8 reference for a ramp",
-                })
-            }
+            check(
+                "accel",
+                accel,
+                "0 for the exact constant-speed discretisation (rad/s^2); use the DoPri8 reference for a ramp",
+                |v| v == 0.0,
+            )?;
+            Ok(omega0)
         }
     }
 }
@@ -104,7 +102,7 @@ pub(crate) fn transition_matrix(rotor: &Rotor, omega: f64, dt: f64) -> Matrix6<f
 }
 
 impl ExactConstant {
-    /// Start at t = 0 from `initial`, sampling period `dt` [s] (finite, > 0). `speed` must
+    /// Start at t = 0 from `initial`, sampling period `dt` \[s\] (finite, > 0). `speed` must
     /// be constant (a [`SpeedProfile::Constant`] or a ramp with zero acceleration).
     pub fn new(
         rotor: &Rotor,
@@ -132,7 +130,7 @@ impl ExactConstant {
         Ok(out)
     }
 
-    /// The sampling period [s].
+    /// The sampling period \[s\].
     pub fn dt(&self) -> f64 {
         self.dt
     }
@@ -140,14 +138,7 @@ impl ExactConstant {
 
 impl Integrator for ExactConstant {
     fn current(&self) -> Sample {
-        Sample {
-            t: self.n as f64 * self.dt,
-            x: self.y[0],
-            z: self.y[1],
-            vx: self.y[2],
-            vz: self.y[3],
-            speed: self.state,
-        }
+        Sample::nth(self.n, self.dt, self.y.into(), self.state)
     }
 
     #[inline]

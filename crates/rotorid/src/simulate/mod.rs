@@ -5,7 +5,7 @@
 //! m z'' + cz z' + a w x'          + kz z = mud ( w' sin(phi+alpha) + w^2 cos(phi+alpha) )
 //! ```
 //!
-//! i.e. `M q'' + C(w) q' + K(w') q = F(t)`, q = (x, z) [m], with the speed profile phi(t),
+//! i.e. `M q'' + C(w) q' + K(w') q = F(t)`, q = (x, z) \[m\], with the speed profile phi(t),
 //! w = phi', w' = phi'' given (see [`crate::model`]).
 //!
 //! Two methods ([`Method`]):
@@ -21,7 +21,7 @@
 //! accumulating dt), starting from t_0 = 0 with the scenario's initial state.
 //!
 //! Also here: [`add_noise`] (white Gaussian measurement noise at a given SNR, reproducible
-//! from a seed) and [`steady_state`] (the closed-form constant-speed steady state, the
+//! from a seed) and [`steady_state()`] (the closed-form constant-speed steady state, the
 //! oracle the tests check the integrators against).
 
 mod error;
@@ -82,34 +82,50 @@ impl FromStr for Method {
 /// The state of the rotor at one sampling instant.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Sample {
-    /// Time t [s] (exactly `i as f64 * dt` for sample i).
+    /// Time t \[s\] (exactly `i as f64 * dt` for sample i).
     pub t: f64,
-    /// Horizontal displacement x [m].
+    /// Horizontal displacement x \[m\].
     pub x: f64,
-    /// Vertical displacement z [m].
+    /// Vertical displacement z \[m\].
     pub z: f64,
-    /// Horizontal velocity x' [m/s].
+    /// Horizontal velocity x' \[m/s\].
     pub vx: f64,
-    /// Vertical velocity z' [m/s].
+    /// Vertical velocity z' \[m/s\].
     pub vz: f64,
-    /// Rotor angle phi [rad], speed w [rad/s] and acceleration w' [rad/s^2] at t.
+    /// Rotor angle phi \[rad\], speed w \[rad/s\] and acceleration w' \[rad/s^2\] at t.
     pub speed: SpeedState,
+}
+
+impl Sample {
+    /// Sample `n` of a record sampled every `dt` \[s\]: t = n dt exactly (never accumulated),
+    /// state (x, z, vx, vz) \[m, m, m/s, m/s\] and `speed` at that instant.
+    #[inline]
+    pub(crate) fn nth(n: u64, dt: f64, [x, z, vx, vz]: [f64; 4], speed: SpeedState) -> Self {
+        Self {
+            t: n as f64 * dt,
+            x,
+            z,
+            vx,
+            vz,
+            speed,
+        }
+    }
 }
 
 /// A simulated record, one entry per sample (column-wise).
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct TimeResponse {
-    /// Time t_i = i dt [s].
+    /// Time t_i = i dt \[s\].
     pub t: Vec<f64>,
-    /// Horizontal displacement x [m].
+    /// Horizontal displacement x \[m\].
     pub x: Vec<f64>,
-    /// Vertical displacement z [m].
+    /// Vertical displacement z \[m\].
     pub z: Vec<f64>,
-    /// Rotor angle phi [rad].
+    /// Rotor angle phi \[rad\].
     pub phi: Vec<f64>,
-    /// Speed w = phi' [rad/s].
+    /// Speed w = phi' \[rad/s\].
     pub phi_dot: Vec<f64>,
-    /// Angular acceleration w' = phi'' [rad/s^2].
+    /// Angular acceleration w' = phi'' \[rad/s^2\].
     pub phi_ddot: Vec<f64>,
 }
 

@@ -45,17 +45,17 @@ use crate::model::{unbalance_force_from, InitialState, Rotor, SpeedProfile, Spee
 pub struct Newmark {
     rotor: Rotor,
     speed: SpeedProfile,
-    /// Step = sampling period [s].
+    /// Step = sampling period \[s\].
     dt: f64,
     /// Index of the current sample.
     n: u64,
     /// Speed state at the current sample.
     state: SpeedState,
-    /// Displacement q_n [m].
+    /// Displacement q_n \[m\].
     u: Vector2<f64>,
-    /// Velocity q'_n [m/s].
+    /// Velocity q'_n \[m/s\].
     v: Vector2<f64>,
-    /// Acceleration q''_n [m/s^2].
+    /// Acceleration q''_n \[m/s^2\].
     a: Vector2<f64>,
     /// m + dt/2 cx + dt^2/4 kx and m + dt/2 cz + dt^2/4 kz: the diagonal of S.
     s_diag: (f64, f64),
@@ -67,7 +67,7 @@ pub struct Newmark {
 }
 
 impl Newmark {
-    /// Start at t = 0 from `initial`, with step `dt` [s] (finite, > 0). The initial
+    /// Start at t = 0 from `initial`, with step `dt` \[s\] (finite, > 0). The initial
     /// acceleration comes from the equation of motion at t = 0.
     pub fn new(
         rotor: &Rotor,
@@ -109,12 +109,12 @@ impl Newmark {
         Ok(out)
     }
 
-    /// The sampling period [s].
+    /// The sampling period \[s\].
     pub fn dt(&self) -> f64 {
         self.dt
     }
 
-    /// The current acceleration (x'', z'') [m/s^2].
+    /// The current acceleration (x'', z'') \[m/s^2\].
     pub fn acceleration(&self) -> Vector2<f64> {
         self.a
     }
@@ -122,14 +122,8 @@ impl Newmark {
 
 impl Integrator for Newmark {
     fn current(&self) -> Sample {
-        Sample {
-            t: self.n as f64 * self.dt,
-            x: self.u[0],
-            z: self.u[1],
-            vx: self.v[0],
-            vz: self.v[1],
-            speed: self.state,
-        }
+        let (u, v) = (self.u, self.v);
+        Sample::nth(self.n, self.dt, [u[0], u[1], v[0], v[1]], self.state)
     }
 
     #[inline]

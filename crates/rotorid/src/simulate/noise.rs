@@ -16,15 +16,16 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
-use super::error::{check, SimulateError};
+use super::error::SimulateError;
 use super::TimeResponse;
+use crate::model::check;
 
 /// The standard deviations of the noise that was added.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NoiseLevel {
-    /// sigma_x [m].
+    /// sigma_x \[m\].
     pub sigma_x: f64,
-    /// sigma_z [m].
+    /// sigma_z \[m\].
     pub sigma_z: f64,
 }
 
@@ -45,7 +46,7 @@ fn rms(channel: &'static str, v: &[f64]) -> Result<f64, SimulateError> {
     Ok(big * mean_sq.sqrt())
 }
 
-/// Add white Gaussian noise to `resp.x` and `resp.z` at `snr_db` [dB] (finite; RMS
+/// Add white Gaussian noise to `resp.x` and `resp.z` at `snr_db` \[dB\] (finite; RMS
 /// definition, see the module doc), reproducibly from `seed`. Returns the sigmas used.
 /// A channel that is identically zero gets no noise (sigma = 0).
 pub fn add_noise(

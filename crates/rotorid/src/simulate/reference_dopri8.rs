@@ -40,9 +40,9 @@
 use russell_lab::Vector;
 use russell_ode::{Method as RussellMethod, NoArgs, OdeSolver, Params, System};
 
-use super::error::{check, check_dt, check_speed, SimulateError};
+use super::error::{check_dt, check_speed, SimulateError};
 use super::{finite, Integrator, Sample};
-use crate::model::{unbalance_force_from, InitialState, Rotor, SpeedProfile, SpeedState};
+use crate::model::{check, unbalance_force_from, InitialState, Rotor, SpeedProfile, SpeedState};
 
 /// Default DoPri8 tolerance (relative, and absolute in scaled units; see the module doc).
 pub const DEFAULT_TOLERANCE: f64 = 1e-13;
@@ -53,9 +53,9 @@ pub struct DoPri8Reference {
     params: Params,
     /// Scaled state (x / L, z / L, vx / (L w0), vz / (L w0)).
     y: Vector,
-    /// Length scale L [m].
+    /// Length scale L \[m\].
     l: f64,
-    /// Velocity scale L w0 [m/s].
+    /// Velocity scale L w0 \[m/s\].
     lv: f64,
     speed: SpeedProfile,
     dt: f64,
@@ -77,7 +77,7 @@ impl std::fmt::Debug for DoPri8Reference {
 }
 
 impl DoPri8Reference {
-    /// Start at t = 0 from `initial`, sampling period `dt` [s] (finite, >= 1e-12), with the
+    /// Start at t = 0 from `initial`, sampling period `dt` \[s\] (finite, >= 1e-12), with the
     /// default tolerance [`DEFAULT_TOLERANCE`].
     pub fn new(
         rotor: &Rotor,
@@ -184,7 +184,7 @@ impl DoPri8Reference {
         Ok(out)
     }
 
-    /// The sampling period [s].
+    /// The sampling period \[s\].
     pub fn dt(&self) -> f64 {
         self.dt
     }
@@ -197,14 +197,14 @@ impl DoPri8Reference {
 
 impl Integrator for DoPri8Reference {
     fn current(&self) -> Sample {
-        Sample {
-            t: self.n as f64 * self.dt,
-            x: self.l * self.y[0],
-            z: self.l * self.y[1],
-            vx: self.lv * self.y[2],
-            vz: self.lv * self.y[3],
-            speed: self.state,
-        }
+        // unscale (x / L, z / L, vx / (L w0), vz / (L w0))
+        let (y, l, lv) = (&self.y, self.l, self.lv);
+        Sample::nth(
+            self.n,
+            self.dt,
+            [l * y[0], l * y[1], lv * y[2], lv * y[3]],
+            self.state,
+        )
     }
 
     fn step(&mut self) -> Result<Sample, SimulateError> {

@@ -26,16 +26,16 @@ use crate::model::Rotor;
 /// The complex amplitudes of the steady-state response at constant speed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SteadyState {
-    /// The speed W [rad/s].
+    /// The speed W \[rad/s\].
     pub omega: f64,
-    /// The unbalance angle alpha [rad] (th = W t + phi0 + alpha).
+    /// The unbalance angle alpha \[rad\] (th = W t + phi0 + alpha).
     pub alpha: f64,
-    /// Q^ = (Q^_x, Q^_z) [m]: x_ss(t) = Re(Q^_x e^{i th}), z_ss likewise. Non-finite when
+    /// Q^ = (Q^_x, Q^_z) \[m\]: x_ss(t) = Re(Q^_x e^{i th}), z_ss likewise. Non-finite when
     /// there is no bounded steady state (see [`SteadyState::is_bounded`]).
     pub q: Vector2<Complex<f64>>,
 }
 
-/// The steady-state response of `rotor` at the constant speed `omega` [rad/s].
+/// The steady-state response of `rotor` at the constant speed `omega` \[rad/s\].
 pub fn steady_state(rotor: &Rotor, omega: f64) -> SteadyState {
     let w = omega;
     let u = rotor.unbalance();
@@ -68,12 +68,12 @@ impl SteadyState {
         self.q.iter().all(|c| c.re.is_finite() && c.im.is_finite())
     }
 
-    /// Amplitudes (|Q^_x|, |Q^_z|) [m].
+    /// Amplitudes (|Q^_x|, |Q^_z|) \[m\].
     pub fn amplitude(&self) -> Vector2<f64> {
         self.q.map(|c| c.norm())
     }
 
-    /// Phases (arg Q^_x, arg Q^_z) [rad], in (-pi, pi]: x_ss = |Q^_x| cos(th + arg Q^_x).
+    /// Phases (arg Q^_x, arg Q^_z) \[rad\], in (-pi, pi]: x_ss = |Q^_x| cos(th + arg Q^_x).
     pub fn phase(&self) -> Vector2<f64> {
         self.q.map(|c| c.arg())
     }
@@ -84,13 +84,13 @@ impl SteadyState {
         Complex::new(c, s)
     }
 
-    /// q_ss(t) = Re(Q^ e^{i th}) [m], for a rotor at angle phi0 [rad] at t = 0.
+    /// q_ss(t) = Re(Q^ e^{i th}) \[m\], for a rotor at angle phi0 \[rad\] at t = 0.
     pub fn displacement(&self, t: f64, phi0: f64) -> Vector2<f64> {
         let e = self.rotor_phasor(t, phi0);
         self.q.map(|c| (c * e).re)
     }
 
-    /// q_ss'(t) = Re(i W Q^ e^{i th}) [m/s], for a rotor at angle phi0 [rad] at t = 0.
+    /// q_ss'(t) = Re(i W Q^ e^{i th}) \[m/s\], for a rotor at angle phi0 \[rad\] at t = 0.
     pub fn velocity(&self, t: f64, phi0: f64) -> Vector2<f64> {
         let e = self.rotor_phasor(t, phi0) * Complex::new(0.0, self.omega);
         self.q.map(|c| (c * e).re)

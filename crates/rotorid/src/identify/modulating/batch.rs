@@ -1,7 +1,7 @@
 //! Whole records: a fold of [`ModulatingIdentifier::push`] over the samples, then one
 //! solve, so a batch gives exactly what the streaming identifier gives.
 
-use super::super::error::IdentifyError;
+use super::super::batch::record_dt;
 use super::super::inputs::{Known, Measurement};
 use super::config::ModulatingConfig;
 use super::error::ModulatingError;
@@ -10,9 +10,9 @@ use super::identifier::ModulatingIdentifier;
 use crate::model::SpeedState;
 use crate::simulate::TimeResponse;
 
-/// Identify m, c, k per direction from a whole record: time `t` [s] (uniform), the
-/// displacements `x`, `z` [m], the rotor angle `phi` [rad], speed `w` [rad/s] and
-/// acceleration `w_dot` [rad/s^2], every column as long as `t` (at least two samples; dt
+/// Identify m, c, k per direction from a whole record: time `t` \[s\] (uniform), the
+/// displacements `x`, `z` \[m\], the rotor angle `phi` \[rad\], speed `w` \[rad/s\] and
+/// acceleration `w_dot` \[rad/s^2\], every column as long as `t` (at least two samples; dt
 /// is `t[1] - t[0]`). The record must hold at least one window.
 #[allow(clippy::too_many_arguments)]
 pub fn identify_modulating(
@@ -25,28 +25,17 @@ pub fn identify_modulating(
     known: Known,
     config: ModulatingConfig,
 ) -> Result<ModulatingEstimate, ModulatingError> {
+    let dt = record_dt(
+        t,
+        [
+            ("x", x.len()),
+            ("z", z.len()),
+            ("phi", phi.len()),
+            ("phi_dot", w.len()),
+            ("phi_ddot", w_dot.len()),
+        ],
+    )?;
     let n = t.len();
-    let columns: [(&'static str, usize); 5] = [
-        ("x", x.len()),
-        ("z", z.len()),
-        ("phi", phi.len()),
-        ("phi_dot", w.len()),
-        ("phi_ddot", w_dot.len()),
-    ];
-    for (column, len) in columns {
-        if len != n {
-            return Err(IdentifyError::ColumnLength {
-                column,
-                len,
-                expected: n,
-            }
-            .into());
-        }
-    }
-    if n < 2 {
-        return Err(IdentifyError::TooFewSamples { samples: n }.into());
-    }
-    let dt = t[1] - t[0];
     let mut id = ModulatingIdentifier::new(known, dt, config)?;
     if n < id.window_samples() {
         return Err(ModulatingError::RecordShorterThanWindow {

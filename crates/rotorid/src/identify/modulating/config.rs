@@ -3,9 +3,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::super::error::{check, IdentifyError};
+use super::super::error::IdentifyError;
+use crate::model::check;
 
-/// Default window length L [s]: 20 ms, about one period of table1's natural frequency
+/// Default window length L \[s\]: 20 ms, about one period of table1's natural frequency
 /// (sqrt(k/m) = 289 rad/s, 21.7 ms). See [`ModulatingConfig::window_s`] for the reasoning;
 /// for another rotor use [`ModulatingConfig::for_natural_frequency`].
 pub const DEFAULT_WINDOW_S: f64 = 0.02;
@@ -34,9 +35,9 @@ pub enum NoiseCompensation {
     Estimated,
     /// Compensate with these noise standard deviations.
     Known {
-        /// sigma_x [m], finite and >= 0.
+        /// sigma_x \[m\], finite and >= 0.
         sigma_x: f64,
-        /// sigma_z [m], finite and >= 0.
+        /// sigma_z \[m\], finite and >= 0.
         sigma_z: f64,
     },
 }
@@ -44,7 +45,7 @@ pub enum NoiseCompensation {
 /// Settings of [`super::ModulatingIdentifier`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ModulatingConfig {
-    /// Window length L [s], finite and > 0; rounded to a whole number of sampling
+    /// Window length L \[s\], finite and > 0; rounded to a whole number of sampling
     /// intervals, which must be at least 8 per test function (and 24).
     ///
     /// Choose about one period of the first natural frequency, 2 pi / w_n (the default,
@@ -61,7 +62,7 @@ pub struct ModulatingConfig {
     /// errors in m and k stay at 1.1e-4 (kz 1.5e-4) and those in c within 25 % of their
     /// best (3e-2); at 50 ms m and k are unchanged but c is 2.5x worse.
     pub window_s: f64,
-    /// Hop between the starts of consecutive windows [s], finite, in
+    /// Hop between the starts of consecutive windows \[s\], finite, in
     /// [`window_s` / [`MAX_OVERLAP`], `window_s`]; rounded to a whole number of sampling intervals (at least one). Default L / 8:
     /// with L / 2 the errors were 2.5x larger, with L / 4 up to 1.8x (depending on the
     /// number of functions), with L / 8 and L / 16 the same (table1, 40 dB).
@@ -90,7 +91,7 @@ impl Default for ModulatingConfig {
 }
 
 impl ModulatingConfig {
-    /// The default configuration with window length `window_s` [s] and hop
+    /// The default configuration with window length `window_s` \[s\] and hop
     /// [`DEFAULT_HOP_FRACTION`] of it (not validated: see [`validated`](Self::validated)).
     pub fn with_window(window_s: f64) -> Self {
         Self {
@@ -101,7 +102,7 @@ impl ModulatingConfig {
     }
 
     /// The default configuration with the window set to one period of the natural
-    /// frequency `omega_n` [rad/s] (finite, > 0; e.g. sqrt(k/m) from a rough guess, a
+    /// frequency `omega_n` \[rad/s\] (finite, > 0; e.g. sqrt(k/m) from a rough guess, a
     /// rap test or the plain algebraic identifier's early estimate): L = 2 pi / omega_n,
     /// hop L / 8.
     pub fn for_natural_frequency(omega_n: f64) -> Result<Self, IdentifyError> {

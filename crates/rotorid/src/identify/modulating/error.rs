@@ -3,6 +3,7 @@
 //! is NaN with rcond = 0).
 
 use super::super::error::IdentifyError;
+use crate::model::OutOfRange;
 
 /// Why the modulating-function identifier could not be built or run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -17,9 +18,9 @@ pub enum ModulatingError {
          must be at least {needed} intervals (8 per test function, {functions} functions, and 24)"
     )]
     WindowTooShort {
-        /// The window length asked for [s].
+        /// The window length asked for \[s\].
         window_s: f64,
-        /// The sampling period [s].
+        /// The sampling period \[s\].
         dt: f64,
         /// The window in sampling intervals (rounded).
         intervals: usize,
@@ -38,9 +39,16 @@ pub enum ModulatingError {
         samples: usize,
         /// Samples in one window.
         needed: usize,
-        /// The window length [s].
+        /// The window length \[s\].
         window_s: f64,
-        /// The sampling period [s].
+        /// The sampling period \[s\].
         dt: f64,
     },
+}
+
+/// An out-of-range value is the same [`IdentifyError`] the algebraic identifier returns.
+impl From<OutOfRange> for ModulatingError {
+    fn from(e: OutOfRange) -> Self {
+        Self::Input(e.into())
+    }
 }

@@ -6,19 +6,19 @@ use serde::{Deserialize, Serialize};
 /// The estimate for one direction (x or z).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ModulatingDirection {
-    /// Mass m [kg] (NaN when the least squares is singular).
+    /// Mass m \[kg\] (NaN when the least squares is singular).
     pub m: f64,
-    /// Damping c [N s/m] (NaN when singular).
+    /// Damping c \[N s/m\] (NaN when singular).
     pub c: f64,
-    /// Stiffness k [N/m] (NaN when singular).
+    /// Stiffness k \[N/m\] (NaN when singular).
     pub k: f64,
-    /// Standard error of m [kg]: first-order sandwich covariance of the least squares with
+    /// Standard error of m \[kg\]: first-order sandwich covariance of the least squares with
     /// the correlations of overlapping windows, for white noise of the estimated (or
     /// given) sigma (module `uncertainty`). NaN when singular.
     pub std_error_m: f64,
-    /// Standard error of c [N s/m] (as `std_error_m`).
+    /// Standard error of c \[N s/m\] (as `std_error_m`).
     pub std_error_c: f64,
-    /// Standard error of k [N/m] (as `std_error_m`).
+    /// Standard error of k \[N/m\] (as `std_error_m`).
     pub std_error_k: f64,
     /// Reciprocal 2-norm condition number of the equilibrated (and noise-compensated)
     /// normal matrix, in [0, 1]; 0 when singular (module `normal_equations`).
@@ -56,7 +56,7 @@ impl ModulatingDirection {
 /// Both directions' estimates from all windows completed so far.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ModulatingEstimate {
-    /// Time of the last sample of the last completed window [s] (NaN before the first).
+    /// Time of the last sample of the last completed window \[s\] (NaN before the first).
     pub t: f64,
     /// Horizontal direction: m, cx, kx.
     pub x: ModulatingDirection,
@@ -64,14 +64,14 @@ pub struct ModulatingEstimate {
     pub z: ModulatingDirection,
     /// Windows completed (each gives `functions` rows per direction).
     pub windows: u64,
-    /// The window length used, L = (whole sampling intervals) * dt [s].
+    /// The window length used, L = (whole sampling intervals) * dt \[s\].
     pub window_s: f64,
-    /// The hop used between window starts [s].
+    /// The hop used between window starts \[s\].
     pub hop_s: f64,
-    /// Noise standard deviation on x [m] used by the bias compensation (when
+    /// Noise standard deviation on x \[m\] used by the bias compensation (when
     /// `compensated`) and the standard errors: estimated from the data or as given.
     pub sigma_x: f64,
-    /// Noise standard deviation on z [m] (as `sigma_x`).
+    /// Noise standard deviation on z \[m\] (as `sigma_x`).
     pub sigma_z: f64,
     /// True when the O(sigma^2) noise bias was compensated.
     pub compensated: bool,

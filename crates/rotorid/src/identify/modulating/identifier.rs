@@ -26,8 +26,8 @@
 
 use std::collections::VecDeque;
 
-use super::super::error::{check, IdentifyError};
-use super::super::identifier::SAMPLING_TOLERANCE;
+use super::super::error::IdentifyError;
+use super::super::identifier::check_on_time;
 use super::super::inputs::{Known, Measurement};
 use super::config::{ModulatingConfig, NoiseCompensation};
 use super::error::ModulatingError;
@@ -36,6 +36,7 @@ use super::noise_estimate::DifferenceNoise;
 use super::normal_equations::Gram;
 use super::test_functions::TestFunctions;
 use super::uncertainty::{add_pair, ClosedWindow, Meat, Overlaps};
+use crate::model::{check, OutOfRange};
 
 /// Sums per test function in an open window (module docs).
 const NSUM: usize = 11;
@@ -54,7 +55,7 @@ struct OpenWindow {
     start: u64,
     /// `NSUM` sums per test function.
     sums: Vec<[f64; NSUM]>,
-    /// w [rad/s] and w' [rad/s^2] at the centre sample.
+    /// w \[rad/s\] and w' \[rad/s^2\] at the centre sample.
     w: f64,
     w_dot: f64,
 }
@@ -79,7 +80,7 @@ pub struct ModulatingIdentifier {
     /// Covariance sums, x and z.
     meat: [Meat; 2],
     windows: u64,
-    /// Time of the last sample of the last completed window [s].
+    /// Time of the last sample of the last completed window \[s\].
     t_window_end: f64,
     noise: [DifferenceNoise; 2],
     /// Samples accepted.
@@ -88,7 +89,7 @@ pub struct ModulatingIdentifier {
 }
 
 impl ModulatingIdentifier {
-    /// An identifier for data sampled every `dt` [s] (finite, > 0) with the known
+    /// An identifier for data sampled every `dt` \[s\] (finite, > 0) with the known
     /// quantities `known` and `config` (validated; the window must span at least
     /// [`MIN_INTERVALS_PER_FUNCTION`] sampling intervals per test function and
     /// [`MIN_INTERVALS`], and at most 1e7 / functions^2).
@@ -109,7 +110,7 @@ impl ModulatingIdentifier {
         }
         // the tables grow as intervals * functions^2 (module `uncertainty`)
         if intervals * (config.functions * config.functions) as f64 > MAX_TABLE {
-            return Err(IdentifyError::OutOfRange {
+            return Err(OutOfRange {
                 field: "window_s",
                 value: config.window_s,
                 allowed: "at most 1e7 / functions^2 sampling intervals (s)",
@@ -143,12 +144,12 @@ impl ModulatingIdentifier {
         self.config
     }
 
-    /// The window length used, L = whole sampling intervals * dt [s].
+    /// The window length used, L = whole sampling intervals * dt \[s\].
     pub fn window_s(&self) -> f64 {
         self.tf.intervals() as f64 * self.dt
     }
 
-    /// The hop used [s].
+    /// The hop used \[s\].
     pub fn hop_s(&self) -> f64 {
         self.hop as f64 * self.dt
     }
@@ -276,7 +277,7 @@ impl ModulatingIdentifier {
         self.windows += 1;
     }
 
-    /// The noise standard deviations (sigma_x, sigma_z) [m] used for the standard
+    /// The noise standard deviations (sigma_x, sigma_z) \[m\] used for the standard
     /// errors: the given ones for [`NoiseCompensation::Known`], else the fourth-difference
     /// estimate (0 before five samples).
     pub fn noise_sigmas(&self) -> (f64, f64) {
@@ -389,19 +390,7 @@ impl ModulatingIdentifier {
             });
         }
         if self.n > 0 {
-            let expected = self.t_prev + self.dt;
-            let tolerance = SAMPLING_TOLERANCE * self.dt
-                + 8.0 * f64::EPSILON * m.t.abs().max(self.t_prev.abs());
-            // t and t_prev are finite here (checked above)
-            if (m.t - expected).abs() > tolerance {
-                return Err(IdentifyError::NonUniformSampling {
-                    index: self.n,
-                    t: m.t,
-                    expected,
-                    tolerance,
-                    dt: self.dt,
-                });
-            }
+            check_on_time(self.n, m.t, self.t_prev, self.dt)?;
         }
         Ok(())
     }

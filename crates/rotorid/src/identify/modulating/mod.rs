@@ -4,7 +4,7 @@
 //!
 //! The algebraic identifier (Barredo et al. 2024; [`super::AlgebraicIdentifier`]) is a
 //! modulating-function method whose kernel tau^2 = (t - t_0)^2 vanishes only at t_0: its
-//! P[y] holds the raw sample tau^2 y(t) and the weights tau^n grow with time, so under
+//! P\[y\] holds the raw sample tau^2 y(t) and the weights tau^n grow with time, so under
 //! noise it drifts (method.md section 6). Here every test function psi vanishes, with its
 //! first derivatives, at BOTH ends of a window [t_j, t_j + L] (Preisig & Rippin, "Theory and
 //! application of the modulating function method", Comput. Chem. Eng. 17, 1993; Shinbrot,

@@ -40,7 +40,7 @@ impl DifferenceNoise {
         self.seen += 1;
     }
 
-    /// sigma_hat [unit of the samples]; NaN before five samples.
+    /// sigma_hat \[unit of the samples\]; NaN before five samples.
     pub(crate) fn sigma(&self) -> f64 {
         if self.seen < 5 {
             return f64::NAN;

@@ -95,9 +95,9 @@ pub(crate) struct ClosedWindow {
     pub start: u64,
     /// phi of each test function, x rows then z rows.
     pub phi: [Vec<[f64; 3]>; 2],
-    /// w [rad/s] at the window's centre.
+    /// w \[rad/s\] at the window's centre.
     pub w: f64,
-    /// w' [rad/s^2] at the window's centre.
+    /// w' \[rad/s^2\] at the window's centre.
     pub w_dot: f64,
 }
 
@@ -123,8 +123,8 @@ fn add_outer(acc: &mut [[f64; 3]; 3], c: f64, u: &[f64; 3], v: &[f64; 3], both: 
 }
 
 /// Add the pairs of rows of windows `early` and `late` (the same window when `lag` = 0)
-/// to the x and z meats. `a` [N s^2/m] is the gyroscopic coefficient, `two_l` = 2 / L
-/// [1/s].
+/// to the x and z meats. `a` \[N s^2/m\] is the gyroscopic coefficient, `two_l` = 2 / L
+/// \[1/s\].
 pub(crate) fn add_pair(
     meat: &mut [Meat; 2],
     ov: &Overlaps,
