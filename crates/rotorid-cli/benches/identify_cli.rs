@@ -19,7 +19,14 @@ fn write_input(dir: &Path) -> PathBuf {
     let csv = dir.join("response.csv");
     // duration = (ROWS - 1) * dt, so the file has exactly ROWS data rows.
     let status = Command::new(rotorid())
-        .args(["simulate", "--scenario", "table1", "--duration", "99.9999", "--out"])
+        .args([
+            "simulate",
+            "--scenario",
+            "table1",
+            "--duration",
+            "99.9999",
+            "--out",
+        ])
         .arg(&csv)
         .status()
         .expect("run rotorid simulate");
