@@ -1,11 +1,9 @@
 //! End-to-end test of `rotorid demo`: it runs, prints every parameter in both settings, and
 //! its JSON agrees with the accuracy the method promises on exact data.
 
-use assert_cmd::Command;
+mod common;
 
-fn rotorid() -> Command {
-    Command::cargo_bin("rotorid").expect("the rotorid binary is built")
-}
+use common::rotorid;
 
 #[test]
 fn demo_prints_every_parameter_in_both_settings() {

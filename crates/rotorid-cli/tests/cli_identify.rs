@@ -3,20 +3,14 @@
 //! is whole rows, streamed as the input arrives, in bounded memory; `--every` and the
 //! summary JSON.
 
+mod common;
+
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command as Std, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use assert_cmd::Command;
-
-fn rotorid() -> Command {
-    Command::cargo_bin("rotorid").expect("the rotorid binary is built")
-}
-
-fn data(name: &str) -> String {
-    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
-}
+use common::{data, rotorid};
 
 /// The table1 response (0.3 s, 3001 samples), simulated once per test binary.
 fn table1_csv() -> &'static str {

@@ -4,30 +4,12 @@
 //! standard errors in the summary; a record without excitation withholds both directions
 //! with a warning; flags of other methods and too-short records are refused.
 
+mod common;
+
 use std::sync::OnceLock;
 
-use assert_cmd::Command;
+use common::{identify_with_summary, simulate, Run};
 use serde_json::Value;
-
-fn rotorid() -> Command {
-    Command::cargo_bin("rotorid").expect("the rotorid binary is built")
-}
-
-/// `simulate ARGS --out -`: the response CSV.
-fn simulate(args: &[&str]) -> String {
-    let out = rotorid()
-        .arg("simulate")
-        .args(args)
-        .args(["--out", "-", "-q"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
 
 /// table1, 0.3 s (3001 samples), SNR 40 dB per channel (seed 21).
 fn table1_noisy() -> &'static str {
@@ -46,35 +28,9 @@ fn table1_noisy() -> &'static str {
     })
 }
 
-/// The result of one `identify` run.
-struct Run {
-    ok: bool,
-    csv: String,
-    stderr: String,
-    summary: Option<Value>,
-}
-
 /// `identify - --scenario table1 --out - --summary S ARGS` on `input`.
 fn identify(input: &str, args: &[&str]) -> Run {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("s.json");
-    let out = rotorid()
-        .args(["identify", "-", "--scenario", "table1", "--out", "-"])
-        .args(["--summary", path.to_str().unwrap()])
-        .args(args)
-        .write_stdin(input.to_owned())
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    assert!(!stderr.contains("panicked"), "panic: {stderr}");
-    Run {
-        ok: out.status.success(),
-        csv: String::from_utf8(out.stdout).unwrap(),
-        stderr,
-        summary: std::fs::read_to_string(&path)
-            .ok()
-            .map(|t| serde_json::from_str(&t).unwrap()),
-    }
+    identify_with_summary(input, &["--scenario", "table1", "--out", "-"], args)
 }
 
 const PARAMS: [&str; 6] = ["m_x", "c_x", "k_x", "m_z", "c_z", "k_z"];

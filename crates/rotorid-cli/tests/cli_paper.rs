@@ -2,14 +2,12 @@
 //! the HTML is self-contained, and results.json holds every case, setting, parameter and
 //! direction with numbers that only a working simulator + identifier would give.
 
+mod common;
+
 use std::path::Path;
 
-use assert_cmd::Command;
+use common::rotorid;
 use serde_json::Value;
-
-fn rotorid() -> Command {
-    Command::cargo_bin("rotorid").unwrap()
-}
 
 fn png_size(path: &Path) -> (u32, u32) {
     let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());

@@ -2,14 +2,12 @@
 //! scenario, honours a time window, and fails clearly on an unknown header, a bad
 //! extension or an empty window.
 
+mod common;
+
 use std::path::Path;
 
-use assert_cmd::Command;
+use common::rotorid;
 use predicates::str::contains;
-
-fn rotorid() -> Command {
-    Command::cargo_bin("rotorid").unwrap()
-}
 
 fn png_size(path: &Path) -> (u32, u32) {
     let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());

@@ -6,34 +6,12 @@
 //! names with the list of allowed ones; the start falls back to the algebraic estimate on
 //! a record shorter than one modulating window.
 
+mod common;
+
 use std::sync::OnceLock;
 
-use assert_cmd::Command;
+use common::{data, identify_with_summary, rotorid, simulate, Run};
 use serde_json::Value;
-
-fn rotorid() -> Command {
-    Command::cargo_bin("rotorid").expect("the rotorid binary is built")
-}
-
-fn data(name: &str) -> String {
-    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-/// `simulate ARGS --out -`: the response CSV.
-fn simulate(args: &[&str]) -> String {
-    let out = rotorid()
-        .arg("simulate")
-        .args(args)
-        .args(["--out", "-", "-q"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
 
 /// table1, 0.3 s (3001 samples), clean.
 fn table1_clean() -> &'static str {
@@ -58,42 +36,10 @@ fn table1_noisy() -> &'static str {
     })
 }
 
-/// The result of one `identify` run.
-struct Run {
-    ok: bool,
-    csv: String,
-    stderr: String,
-    summary: Option<Value>,
-}
-
 /// `identify - --scenario SCENARIO --method refine --out - --summary S ARGS` on `input`.
 fn refine(input: &str, scenario: &str, args: &[&str]) -> Run {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("s.json");
-    let out = rotorid()
-        .args([
-            "identify",
-            "-",
-            "--scenario",
-            scenario,
-            "--method",
-            "refine",
-        ])
-        .args(["--out", "-", "--summary", path.to_str().unwrap()])
-        .args(args)
-        .write_stdin(input.to_owned())
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    assert!(!stderr.contains("panicked"), "panic: {stderr}");
-    Run {
-        ok: out.status.success(),
-        csv: String::from_utf8(out.stdout).unwrap(),
-        stderr,
-        summary: std::fs::read_to_string(&path)
-            .ok()
-            .map(|t| serde_json::from_str(&t).unwrap()),
-    }
+    let options = ["--scenario", scenario, "--method", "refine", "--out", "-"];
+    identify_with_summary(input, &options, args)
 }
 
 /// Column `col` of a response CSV (after the header).

@@ -2,15 +2,9 @@
 //! mistake (unknown key, missing key, wrong type, out-of-range value, bad TOML) is refused
 //! with a message naming the file, the line and the key, with a non-zero exit and no panic.
 
-use assert_cmd::Command;
+mod common;
 
-fn rotorid() -> Command {
-    Command::cargo_bin("rotorid").expect("the rotorid binary is built")
-}
-
-fn data(name: &str) -> String {
-    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
-}
+use common::{data, rotorid};
 
 fn simulate(scenario: &str, extra: &[&str]) -> std::process::Output {
     rotorid()

@@ -2,13 +2,11 @@
 //! exactly, values that parse back to the library's own bits), the methods, the noise
 //! (reproducible from its seed) and the output file handling.
 
-use assert_cmd::Command;
+mod common;
+
+use common::rotorid;
 use rotorid::simulate::{simulate, Method};
 use rotorid::Scenario;
-
-fn rotorid() -> Command {
-    Command::cargo_bin("rotorid").expect("the rotorid binary is built")
-}
 
 /// Run `rotorid simulate ARGS --out -` and return stdout.
 fn simulate_stdout(args: &[&str]) -> String {

@@ -31,8 +31,8 @@ use anyhow::Context as _;
 use rotorid::identify::Quadrature;
 
 use crate::io::{
-    is_broken_pipe, open_input, FileMode, FlushBeforeRead, Output, ParameterSet, ScenarioSpec,
-    SharedWriter, Summary, Truth, SUMMARY_FORMAT_VERSION,
+    is_broken_pipe, open_input, EstimateRow, EstimatesWriter, FileMode, FlushBeforeRead, Output,
+    ParameterSet, ScenarioSpec, SharedWriter, Summary, Truth, SUMMARY_FORMAT_VERSION,
 };
 
 // The defaults shown in `--help`, each written once (a test keeps them equal to the
@@ -422,6 +422,34 @@ pub(crate) fn base_summary(ctx: &Context, method: IdentifyMethod) -> Summary {
             ctx.settings.rcond_min_for(method),
         )
     }
+}
+
+/// The CSV values of an estimate: (m, c, k) of x and of z, each kept only where its
+/// direction is well conditioned (`ok` = [x, z]) and the value is finite.
+pub(crate) fn kept_values(x: [f64; 3], z: [f64; 3], ok: [bool; 2]) -> ParameterSet<Option<f64>> {
+    let keep = |v: f64, ok: bool| (ok && v.is_finite()).then_some(v);
+    ParameterSet {
+        m_x: keep(x[0], ok[0]),
+        c_x: keep(x[1], ok[0]),
+        k_x: keep(x[2], ok[0]),
+        m_z: keep(z[0], ok[1]),
+        c_z: keep(z[1], ok[1]),
+        k_z: keep(z[2], ok[1]),
+    }
+}
+
+/// Write the estimates CSV of a batch method: the header and its one `row`, to `out`
+/// (named `out_name` in the error).
+pub(crate) fn write_single_row(
+    out: SharedWriter<Output>,
+    out_name: &str,
+    row: &EstimateRow,
+) -> anyhow::Result<()> {
+    let mut writer =
+        EstimatesWriter::new(out).with_context(|| format!("cannot write {out_name}"))?;
+    writer
+        .write(row)
+        .with_context(|| format!("cannot write {out_name}"))
 }
 
 impl Settings {

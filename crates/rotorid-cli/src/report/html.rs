@@ -50,7 +50,6 @@ struct View<'a> {
 
 /// The page for `report`, reading the PNG of every figure from `dir`.
 pub fn render(report: &Report, dir: &Path) -> anyhow::Result<String> {
-    let r = &report.scenario.rotor;
     let b64 = base64::engine::general_purpose::STANDARD;
     let mut figures = Vec::with_capacity(report.figures.len());
     for f in &report.figures {
@@ -68,24 +67,7 @@ pub fn render(report: &Report, dir: &Path) -> anyhow::Result<String> {
     let view = View {
         title: "Barredo et al. (2024), figures 2-9, reproduced by rotorid",
         generator: &report.generator,
-        scenario: format!(
-            "Rotor {} (the paper's Table 1): m = {} kg, cx = {} N s/m, cz = {} N s/m, kx = {} N/m, \
-             kz = {} N/m, a = {} N s\u{b2}/m, m_u = {} kg, d = {} m, alpha = {}\u{b0}. Sampling \
-             period {} ms, record 0-{} s, {} initial state, phi(0) = 0.",
-            report.scenario.name,
-            r.m,
-            r.cx,
-            r.cz,
-            r.kx,
-            r.kz,
-            r.a,
-            r.unbalance.m_u,
-            r.unbalance.d,
-            r.unbalance.alpha.to_degrees(),
-            report.scenario.dt * 1e3,
-            report.scenario.duration,
-            report.scenario.initial_state
-        ),
+        scenario: report.scenario.description(report.scenario.name),
         settings: &report.settings,
         method_note: format!(
             "Estimates are read at t = {} s (the last well-conditioned instant at or before it). \

@@ -68,6 +68,34 @@ pub struct ScenarioInfo {
     pub initial_state: &'static str,
 }
 
+impl ScenarioInfo {
+    /// The sentence both documents open with: the rotor's parameters, the sampling and the
+    /// initial state, in the units they are quoted in (kg, N s/m, N/m, N s^2/m, m, degrees,
+    /// ms, s). `name` is the scenario name as the document shows it (the markdown wraps it
+    /// in backticks).
+    pub fn description(&self, name: &str) -> String {
+        let r = &self.rotor;
+        format!(
+            "Rotor {} (the paper's Table 1): m = {} kg, cx = {} N s/m, cz = {} N s/m, \
+             kx = {} N/m, kz = {} N/m, a = {} N s\u{b2}/m, m_u = {} kg, d = {} m, alpha = {}\u{b0}. \
+             Sampling period {} ms, record 0-{} s, {} initial state, phi(0) = 0.",
+            name,
+            r.m,
+            r.cx,
+            r.cz,
+            r.kx,
+            r.kz,
+            r.a,
+            r.unbalance.m_u,
+            r.unbalance.d,
+            r.unbalance.alpha.to_degrees(),
+            self.dt * 1e3,
+            self.duration,
+            self.initial_state,
+        )
+    }
+}
+
 /// One setting.
 #[derive(Debug, Clone, Serialize)]
 pub struct SettingInfo {

@@ -27,7 +27,7 @@ use rotorid::identify::{
 };
 
 use super::speed::SpeedSource;
-use super::{base_summary, truth_set, Context, IdentifyMethod};
+use super::{base_summary, kept_values, truth_set, Context, IdentifyMethod};
 use crate::io::summary::relative_errors;
 use crate::io::{
     CsvError, Directions, EstimateRow, EstimatesWriter, Output, ParameterSet, ResponseReader,
@@ -153,17 +153,9 @@ pub(crate) fn too_few_rows(name: &str, rows: u64, needed: u64, why: &str) -> Csv
 
 /// The CSV row of an estimate: m, c, k only where the direction is well conditioned.
 fn row_of(e: &Estimate, ok: [bool; 2]) -> EstimateRow {
-    let keep = |v: f64, ok: bool| (ok && v.is_finite()).then_some(v);
     EstimateRow {
         t: e.t,
-        values: ParameterSet {
-            m_x: keep(e.x.m, ok[0]),
-            c_x: keep(e.x.c, ok[0]),
-            k_x: keep(e.x.k, ok[0]),
-            m_z: keep(e.z.m, ok[1]),
-            c_z: keep(e.z.c, ok[1]),
-            k_z: keep(e.z.k, ok[1]),
-        },
+        values: kept_values(e.x.theta(), e.z.theta(), ok),
         rcond_x: e.x.rcond,
         rcond_z: e.z.rcond,
     }

@@ -13,7 +13,6 @@
 
 use std::io::Read;
 
-use anyhow::Context as _;
 use rotorid::identify::modulating::{
     ModulatingConfig, ModulatingError, ModulatingEstimate, ModulatingIdentifier,
 };
@@ -21,13 +20,10 @@ use rotorid::identify::Measurement;
 
 use super::algebraic::too_few_rows;
 use super::speed::SpeedSource;
-use super::{base_summary, truth_set, Context, IdentifyMethod};
+use super::{base_summary, kept_values, truth_set, write_single_row, Context, IdentifyMethod};
 use crate::io::params::PARAMETER_NAMES;
 use crate::io::summary::{relative_errors, ModulatingSummary};
-use crate::io::{
-    CsvError, Directions, EstimateRow, EstimatesWriter, Output, ParameterSet, ResponseReader,
-    SharedWriter, Summary,
-};
+use crate::io::{CsvError, Directions, EstimateRow, Output, ResponseReader, SharedWriter, Summary};
 
 /// The identifier's configuration: the library's defaults with `--window` and the
 /// modulating `--rcond-min`.
@@ -103,26 +99,17 @@ pub(crate) fn run<R: Read>(
 
     let rcond_min = ctx.settings.rcond_min_modulating;
     let ok = est.well_conditioned(rcond_min);
-    let keep = |v: f64, ok: bool| (ok && v.is_finite()).then_some(v);
-    let values = ParameterSet {
-        m_x: keep(est.x.m, ok[0]),
-        c_x: keep(est.x.c, ok[0]),
-        k_x: keep(est.x.k, ok[0]),
-        m_z: keep(est.z.m, ok[1]),
-        c_z: keep(est.z.c, ok[1]),
-        k_z: keep(est.z.k, ok[1]),
-    };
-    let out_name = args.out.clone();
-    let mut writer =
-        EstimatesWriter::new(out).with_context(|| format!("cannot write {out_name}"))?;
-    writer
-        .write(&EstimateRow {
+    let values = kept_values(est.x.theta(), est.z.theta(), ok);
+    write_single_row(
+        out,
+        &args.out,
+        &EstimateRow {
             t: t_last,
             values,
             rcond_x: est.x.rcond,
             rcond_z: est.z.rcond,
-        })
-        .with_context(|| format!("cannot write {out_name}"))?;
+        },
+    )?;
 
     let truth = truth_set(&ctx.view.truth);
     let mut s = base_summary(ctx, IdentifyMethod::Modulating);

@@ -18,7 +18,6 @@
 
 use std::io::Read;
 
-use anyhow::Context as _;
 use rotorid::refine::{crb, refine, Record, RefineOptions, Refined, SpeedData, Unknowns, Warning};
 use rotorid::{InitialState, RotorParams, Unbalance};
 
@@ -26,11 +25,13 @@ use super::algebraic::too_few_rows;
 use super::record::RecordData;
 use super::speed::{shifted, SpeedSource};
 use super::start::{self, ScenarioValues, Source, Start, MCK};
-use super::{base_summary, modulating, truth_set, Context, IdentifyMethod, UnknownName};
+use super::{
+    base_summary, modulating, truth_set, write_single_row, Context, IdentifyMethod, UnknownName,
+};
 use crate::io::summary::{relative_errors, Named, StartSummary};
 use crate::io::{
-    CsvError, Directions, EstimateRow, EstimatesWriter, Output, ParameterSet, ResponseReader,
-    SharedWriter, SimulationOverrides, Summary,
+    CsvError, Directions, EstimateRow, Output, ParameterSet, ResponseReader, SharedWriter,
+    SimulationOverrides, Summary,
 };
 
 /// Fewest rows refine accepts: its algebraic fallback start needs 4 (module `algebraic`).
@@ -181,17 +182,16 @@ pub(crate) fn run<R: Read>(
     } else {
         0.0
     };
-    let out_name = args.out.clone();
-    let mut writer =
-        EstimatesWriter::new(out).with_context(|| format!("cannot write {out_name}"))?;
-    writer
-        .write(&EstimateRow {
+    write_single_row(
+        out,
+        &args.out,
+        &EstimateRow {
             t: t_last,
             values,
             rcond_x: rcond,
             rcond_z: rcond,
-        })
-        .with_context(|| format!("cannot write {out_name}"))?;
+        },
+    )?;
 
     let finite = |v: f64| v.is_finite().then_some(v);
     let truth = truth_set(&ctx.view.truth);

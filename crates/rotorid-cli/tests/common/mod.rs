@@ -1,0 +1,70 @@
+//! Helpers shared by the end-to-end tests in `tests/cli_*.rs`: the `rotorid` command, the
+//! path of a file in `tests/data`, a `simulate` run to a CSV string and an `identify` run
+//! that also reads back its summary JSON. Each test binary uses only some of them.
+
+use assert_cmd::Command;
+use serde_json::Value;
+
+/// The `rotorid` binary of this build.
+#[allow(dead_code)]
+pub fn rotorid() -> Command {
+    Command::cargo_bin("rotorid").expect("the rotorid binary is built")
+}
+
+/// Path of `tests/data/NAME`.
+#[allow(dead_code)]
+pub fn data(name: &str) -> String {
+    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `simulate ARGS --out -`: the response CSV.
+#[allow(dead_code)]
+pub fn simulate(args: &[&str]) -> String {
+    let out = rotorid()
+        .arg("simulate")
+        .args(args)
+        .args(["--out", "-", "-q"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// The result of one `identify` run.
+#[allow(dead_code)]
+pub struct Run {
+    pub ok: bool,
+    pub csv: String,
+    pub stderr: String,
+    pub summary: Option<Value>,
+}
+
+/// `identify - OPTIONS --summary S ARGS` on `input`, S a temporary file read back as JSON
+/// (`None` if the run wrote none). Panics if the binary panicked.
+#[allow(dead_code)]
+pub fn identify_with_summary(input: &str, options: &[&str], args: &[&str]) -> Run {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.json");
+    let out = rotorid()
+        .args(["identify", "-"])
+        .args(options)
+        .args(["--summary", path.to_str().unwrap()])
+        .args(args)
+        .write_stdin(input.to_owned())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    Run {
+        ok: out.status.success(),
+        csv: String::from_utf8(out.stdout).unwrap(),
+        stderr,
+        summary: std::fs::read_to_string(&path)
+            .ok()
+            .map(|t| serde_json::from_str(&t).unwrap()),
+    }
+}
