@@ -8,9 +8,10 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use rotorid::identify::{
-    measurement, AlgebraicIdentifier, IdentifierConfig, Known, Measurement, Quadrature, SpeedModel,
+use rotorid::identify::algebraic::{
+    measurement, AlgebraicConfig, AlgebraicIdentifier, Quadrature, SpeedModel,
 };
+use rotorid::identify::{Known, Measurement};
 use rotorid::simulate::{simulate, Method};
 use rotorid::{Sampling, Scenario};
 
@@ -46,11 +47,11 @@ fn bench(c: &mut Criterion) {
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(3));
     for q in [Quadrature::AdamsMoulton5, Quadrature::Trapezoid] {
-        let general = IdentifierConfig {
+        let general = AlgebraicConfig {
             quadrature: q,
-            ..IdentifierConfig::default()
+            ..AlgebraicConfig::default()
         };
-        let constant = IdentifierConfig {
+        let constant = AlgebraicConfig {
             speed_model: SpeedModel::Constant {
                 omega: w,
                 phi0: 0.0,

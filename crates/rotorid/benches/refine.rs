@@ -9,10 +9,11 @@
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use rotorid::identify::{identify_response, IdentifierConfig, Known};
+use rotorid::identify::algebraic::{identify_response, AlgebraicConfig};
+use rotorid::identify::Known;
 use rotorid::model::{InitialState, RotorParams, Scenario};
 use rotorid::refine::{
-    crb_at_snr, model_response, refine, Experiment, Integrator, Record, RefineOptions, Unknowns,
+    crb_at_snr, model_response, refine, Discretisation, Experiment, Record, RefineOptions, Unknowns,
 };
 use rotorid::simulate::{add_noise, simulate, Method, TimeResponse};
 
@@ -24,7 +25,7 @@ fn noisy(s: &Scenario) -> TimeResponse {
 
 /// The algebraic identifier's estimate at t = 0.05 s (before noise makes it drift).
 fn algebraic_start(s: &Scenario, r: &TimeResponse) -> RotorParams {
-    let est = identify_response(r, Known::from_rotor(&s.rotor), IdentifierConfig::default())
+    let est = identify_response(r, Known::from_rotor(&s.rotor), AlgebraicConfig::default())
         .expect("identify");
     let e = est[500];
     RotorParams {
@@ -84,7 +85,7 @@ fn bench_refine(c: &mut Criterion) {
         let exp = Experiment::from_scenario(&s);
         let p = s.rotor.params();
         g.bench_function(format!("{label}_one_pass_response_only"), |b| {
-            b.iter(|| model_response(&p, &s.initial, &exp, Integrator::Auto).expect("response"))
+            b.iter(|| model_response(&p, &s.initial, &exp, Discretisation::Auto).expect("response"))
         });
     }
     g.finish();

@@ -31,8 +31,9 @@ use std::fmt::Write as _;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
+use rotorid::identify::algebraic::{identify_response, AlgebraicConfig};
 use rotorid::identify::modulating::{identify_modulating_response, ModulatingConfig};
-use rotorid::identify::{identify_response, IdentifierConfig, Known};
+use rotorid::identify::Known;
 use rotorid::model::{InitialState, RotorParams, Sampling, Scenario};
 use rotorid::refine::{crb_at_snr, refine, Record, RefineOptions, Unknowns};
 use rotorid::simulate::{add_noise, simulate, Method, TimeResponse};
@@ -247,7 +248,7 @@ fn run_one(case: &Case, index: usize, seed: u64) -> Run {
     add_noise(&mut r, case.snr, 1_000_000 * index as u64 + seed).expect("noise");
 
     // plain algebraic: the last well-conditioned instant
-    let cfg = IdentifierConfig::default();
+    let cfg = AlgebraicConfig::default();
     let plain_values = identify_response(&r, known, cfg)
         .ok()
         .and_then(|est| {

@@ -12,9 +12,11 @@
 
 pub mod identify;
 pub mod model;
+pub mod parameter;
 pub mod refine;
 pub mod simulate;
 
 pub use model::{
     InitialState, Rotor, RotorParams, Sampling, Scenario, SpeedProfile, SpeedState, Unbalance,
 };
+pub use parameter::Parameter;

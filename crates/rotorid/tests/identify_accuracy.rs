@@ -5,7 +5,7 @@
 mod identify_common;
 
 use identify_common::*;
-use rotorid::identify::{Quadrature, DEFAULT_RCOND_MIN};
+use rotorid::identify::algebraic::{Quadrature, DEFAULT_ALGEBRAIC_RCOND_MIN};
 use rotorid::simulate::Method;
 use rotorid::Scenario;
 
@@ -36,7 +36,7 @@ fn check_within_1_percent_from_20ms(name: &str, sc: &Scenario) {
     let mut total = 0usize;
     let mut worst: f64 = 0.0;
     for e in est.iter().filter(|e| e.t >= 0.02 - 1e-12) {
-        let ok = e.well_conditioned(DEFAULT_RCOND_MIN);
+        let ok = e.well_conditioned(DEFAULT_ALGEBRAIC_RCOND_MIN);
         let err = rel_errors(e, &truth);
         for (d, &well) in ok.iter().enumerate() {
             total += 1;

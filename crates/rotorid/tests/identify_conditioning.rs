@@ -1,10 +1,10 @@
-//! Calibration of the default conditioning threshold (`DEFAULT_RCOND_MIN`) on table1,
+//! Calibration of the default conditioning threshold (`DEFAULT_ALGEBRAIC_RCOND_MIN`) on table1,
 //! exact data: the spikes where A(t) passes near singularity are flagged, the rest are not.
 
 mod identify_common;
 
 use identify_common::*;
-use rotorid::identify::{ConvergenceTracker, Parameter, Quadrature, DEFAULT_RCOND_MIN};
+use rotorid::identify::algebraic::{ConvergenceTracker, Quadrature, DEFAULT_ALGEBRAIC_RCOND_MIN};
 use rotorid::simulate::Method;
 
 #[test]
@@ -23,7 +23,7 @@ fn spikes_are_flagged_and_little_else() {
                     .fold(0.0f64, |a, v| a.max(v.abs()));
                 rconds.push(dir.rcond);
                 total += 1;
-                let is_flagged = !dir.well_conditioned(DEFAULT_RCOND_MIN);
+                let is_flagged = !dir.well_conditioned(DEFAULT_ALGEBRAIC_RCOND_MIN);
                 flagged += is_flagged as usize;
                 if max_err > 1e-3 {
                     spikes += 1;
@@ -45,12 +45,12 @@ fn spikes_are_flagged_and_little_else() {
             worst.0, worst.1
         );
         // The worst instant is a near-singular one, orders of magnitude below the median.
-        assert!(worst.1 < DEFAULT_RCOND_MIN && worst.1 < 1e-2 * median);
+        assert!(worst.1 < DEFAULT_ALGEBRAIC_RCOND_MIN && worst.1 < 1e-2 * median);
         assert!(
             (flagged as f64) < 0.01 * total as f64,
             "{name}: {flagged}/{total}"
         );
-        assert!(median > 100.0 * DEFAULT_RCOND_MIN);
+        assert!(median > 100.0 * DEFAULT_ALGEBRAIC_RCOND_MIN);
     }
 }
 
@@ -60,19 +60,15 @@ fn flagged_instants_never_count_as_converged() {
     // the record can push the identification time of c to near the end.
     let (_, sc) = &table1_cases(1.0)[0];
     let est = estimates(sc, &response(sc, Method::Exact), Quadrature::default());
-    let mut tr = ConvergenceTracker::new(0.01, DEFAULT_RCOND_MIN).unwrap();
+    let mut tr = ConvergenceTracker::new(0.01, DEFAULT_ALGEBRAIC_RCOND_MIN).unwrap();
     for e in &est {
         tr.push(e);
     }
     let truth = truth(sc);
-    for p in Parameter::ALL {
-        let r = tr.result(p);
+    for (i, r) in tr.results().into_iter().enumerate() {
+        let p = r.parameter;
         let f = r.final_value.unwrap();
-        assert!(
-            ((f - truth[p.index()]) / truth[p.index()]).abs() < 1e-3,
-            "{}",
-            p.name()
-        );
+        assert!(((f - truth[i]) / truth[i]).abs() < 1e-3, "{}", p.name());
         let t = r.identification_time.unwrap();
         // m and k within 1 % from the first 20 ms at the latest; c too on exact data.
         assert!(t <= 0.02, "{}: identified at {t} s", p.name());
@@ -98,5 +94,5 @@ fn the_first_samples_are_singular() {
     assert_eq!(est[0].x.rcond, 0.0);
     assert!(est[0].x.m.is_nan());
     // tau = dt: A is numerically singular (rcond ~ 1e-17) or flagged.
-    assert!(!est[1].x.well_conditioned(DEFAULT_RCOND_MIN));
+    assert!(!est[1].x.well_conditioned(DEFAULT_ALGEBRAIC_RCOND_MIN));
 }

@@ -3,9 +3,10 @@
 //! for a band narrowed by the reported resolution. Bounded memory on long records.
 
 use proptest::prelude::*;
-use rotorid::identify::{
-    ConvergenceTracker, DirectionEstimate, Estimate, Parameter, DEFAULT_STACK_CAPACITY,
+use rotorid::identify::algebraic::{
+    AlgebraicEstimate, ConvergenceTracker, DirectionEstimate, DEFAULT_STACK_CAPACITY,
 };
+use rotorid::Parameter;
 
 /// (t, value, well conditioned)
 type Seq = Vec<(f64, f64, bool)>;
@@ -41,7 +42,7 @@ fn track(x: &Seq, z: &Seq, tol: f64, cap: usize) -> ConvergenceTracker {
             k: 1e6 * s.1,
             rcond: if s.2 { 1.0 } else { 0.1 },
         };
-        tr.push(&Estimate {
+        tr.push(&AlgebraicEstimate {
             t: a.0,
             x: dir(a),
             z: dir(b),
@@ -51,7 +52,7 @@ fn track(x: &Seq, z: &Seq, tol: f64, cap: usize) -> ConvergenceTracker {
 }
 
 fn component(seq: &Seq, p: Parameter) -> Seq {
-    let scale = [1.0, -1.0, 1e6][p.index() % 3];
+    let scale = [1.0, -1.0, 1e6][ix(p) % 3];
     seq.iter().map(|&(t, v, ok)| (t, scale * v, ok)).collect()
 }
 
@@ -75,9 +76,9 @@ fn sequences() -> impl Strategy<Value = (Seq, Seq)> {
 
 fn check_exact(x: &Seq, z: &Seq, tol: f64) {
     let tr = track(x, z, tol, 1 << 20);
-    for p in Parameter::ALL {
-        let seq = component(if p.index() < 3 { x } else { z }, p);
-        let r = tr.result(p);
+    for p in Parameter::PER_DIRECTION {
+        let seq = component(if ix(p) < 3 { x } else { z }, p);
+        let r = tr.result(p).unwrap();
         assert_eq!(r.resolution, 0.0);
         match band(&seq, tol) {
             None => {
@@ -114,9 +115,9 @@ proptest! {
     fn conservative_with_merging((x, z) in sequences(), tol in 0.0f64..0.2, cap in 2usize..12) {
         let tr = track(&x, &z, tol, cap);
         prop_assert!(tr.stack_entries() <= 12 * cap);
-        for p in Parameter::ALL {
-            let seq = component(if p.index() < 3 { &x } else { &z }, p);
-            let r = tr.result(p);
+        for p in Parameter::PER_DIRECTION {
+            let seq = component(if ix(p) < 3 { &x } else { &z }, p);
+            let r = tr.result(p).unwrap();
             let Some((f, lo, hi)) = band(&seq, tol) else { continue };
             prop_assert_eq!(r.final_value, Some(f));
             let inf = f64::INFINITY;
@@ -149,7 +150,7 @@ fn a_converging_sequence_reports_when_it_entered_the_band_for_good() {
             k: v,
             rcond: 1.0,
         };
-        tr.push(&Estimate { t, x: d, z: d });
+        tr.push(&AlgebraicEstimate { t, x: d, z: d });
     }
     for r in tr.results() {
         assert_eq!(
@@ -168,13 +169,13 @@ fn a_converging_sequence_reports_when_it_entered_the_band_for_good() {
         k: 1e9,
         rcond: 1e-9,
     };
-    tr.push(&Estimate {
+    tr.push(&AlgebraicEstimate {
         t: 10.001,
         x: d,
         z: d,
     });
     assert_eq!(
-        tr.result(Parameter::Kz).identification_time,
+        tr.result(Parameter::Kz).unwrap().identification_time,
         Some(last_out + dt)
     );
     assert_eq!(tr.estimates(), 10_002);
@@ -202,14 +203,19 @@ fn two_million_estimates_in_bounded_memory() {
             k: 1e5 * v,
             rcond: 1.0,
         };
-        tr.push(&Estimate { t, x: d, z: d });
+        tr.push(&AlgebraicEstimate { t, x: d, z: d });
     }
     assert!(tr.stack_entries() <= 12 * DEFAULT_STACK_CAPACITY);
-    let r = tr.result(Parameter::Mx);
+    let r = tr.result(Parameter::MX).unwrap();
     let t = r.identification_time.unwrap();
     // Truth: the drift is 1e-6 per sample from 14 + 2 down to 14; 1 % of 14.000001 is
     // 0.14, reached when 1e-6 (n - i) <= 0.14 -> i >= n - 140000, i.e. t ~ 186 s (noise
     // +-5e-5 moves it by ~50 samples).
     assert!((t - 186.0).abs() < 0.1, "identification time {t}");
     assert!(r.resolution < 0.01 * 14.0, "resolution {}", r.resolution);
+}
+
+/// Position of `p` in an estimate's per-direction values.
+fn ix(p: Parameter) -> usize {
+    p.direction_index().unwrap()
 }

@@ -6,10 +6,11 @@ mod identify_common;
 
 use identify_common::*;
 use nalgebra::{Matrix3, Vector3};
-use rotorid::identify::{
-    identify_batch, identify_response, measurement, AlgebraicIdentifier, IdentifierConfig, Known,
-    Measurement, Quadrature, SpeedModel,
+use rotorid::identify::algebraic::{
+    identify_batch, identify_response, measurement, AlgebraicConfig, AlgebraicIdentifier,
+    Quadrature, SpeedModel,
 };
+use rotorid::identify::{Known, Measurement};
 use rotorid::model::rpm_to_rad_per_s;
 use rotorid::simulate::{simulate, Method};
 use rotorid::{Sampling, Scenario, SpeedProfile};
@@ -33,11 +34,11 @@ fn constant_speed_mode_agrees_with_the_general_mode_on_constant_speed_data() {
     let resp = simulate(&sc, Method::Exact).unwrap();
     let known = Known::from_rotor(&sc.rotor);
     for q in Quadrature::ALL {
-        let general = IdentifierConfig {
+        let general = AlgebraicConfig {
             quadrature: q,
-            ..IdentifierConfig::default()
+            ..AlgebraicConfig::default()
         };
-        let constant = IdentifierConfig {
+        let constant = AlgebraicConfig {
             speed_model: SpeedModel::Constant { omega: w, phi0 },
             ..general
         };
@@ -149,9 +150,9 @@ fn constant_speed_formulas_match_an_independent_slow_reference() {
     let cos: Vec<f64> = phase.iter().map(|p| p.cos()).collect();
     let rx = Reference::new(&resp.t, &resp.x, &resp.z, &sin, &known, w, 1.0);
     let rz = Reference::new(&resp.t, &resp.z, &resp.x, &cos, &known, w, -1.0);
-    let config = IdentifierConfig {
+    let config = AlgebraicConfig {
         quadrature: Quadrature::Trapezoid,
-        ..IdentifierConfig::constant_speed(w, phi0).unwrap()
+        ..AlgebraicConfig::constant_speed(w, phi0).unwrap()
     };
     let est = identify_response(&resp, known, config).unwrap();
     let mut compared = 0;
@@ -185,16 +186,16 @@ fn batch_is_the_streaming_fold_bit_for_bit() {
     let known = Known::from_rotor(&sc.rotor);
     let ms: Vec<Measurement> = (0..resp.len()).map(|i| measurement(&resp, i)).collect();
     for q in Quadrature::ALL {
-        let config = IdentifierConfig {
+        let config = AlgebraicConfig {
             quadrature: q,
-            ..IdentifierConfig::default()
+            ..AlgebraicConfig::default()
         };
         let batch = identify_batch(&ms, known, 1e-4, config).unwrap();
         let from_response = identify_response(&resp, known, config).unwrap();
         let mut id = AlgebraicIdentifier::new(known, 1e-4, config).unwrap();
         for ((m, b), r) in ms.iter().zip(&batch).zip(&from_response) {
             let s = id.push(m).unwrap();
-            let bits = |e: &rotorid::identify::Estimate| {
+            let bits = |e: &rotorid::identify::algebraic::AlgebraicEstimate| {
                 let v = e.values();
                 [
                     v[0], v[1], v[2], v[3], v[4], v[5], e.x.rcond, e.z.rcond, e.t,
@@ -213,7 +214,7 @@ fn reset_restarts_from_the_next_sample() {
     sc.sampling = Sampling::new(1e-4, 0.2).unwrap();
     let resp = simulate(&sc, Method::Exact).unwrap();
     let known = Known::from_rotor(&sc.rotor);
-    let config = IdentifierConfig::default();
+    let config = AlgebraicConfig::default();
     let mut id = AlgebraicIdentifier::new(known, 1e-4, config).unwrap();
     for i in 0..500 {
         id.push(&measurement(&resp, i)).unwrap();

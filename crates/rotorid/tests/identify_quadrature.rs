@@ -2,7 +2,7 @@
 //! first sample (start-up included): halving h must divide the error by 2^order at every
 //! level. A wrong coefficient breaks the order, so this fails.
 
-use rotorid::identify::{Quadrature, RunningIntegrals, LEVELS};
+use rotorid::identify::algebraic::{Quadrature, RunningIntegrals, LEVELS};
 
 /// I1..I4 of cos from 0: sin t, 1 - cos t, t - sin t, t^2/2 - 1 + cos t.
 fn exact(t: f64) -> [f64; LEVELS] {

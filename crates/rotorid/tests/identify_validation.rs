@@ -2,10 +2,11 @@
 //! allowed range; a rejected measurement leaves the identifier unchanged; singular systems
 //! are not errors.
 
-use rotorid::identify::{
-    identify_batch, identify_response, AlgebraicIdentifier, ConvergenceTracker, IdentifierConfig,
-    IdentifyError, Known, Measurement, Quadrature, SpeedModel,
+use rotorid::identify::algebraic::{
+    identify_batch, identify_response, AlgebraicConfig, AlgebraicError, AlgebraicIdentifier,
+    ConvergenceTracker, Quadrature, SpeedModel,
 };
+use rotorid::identify::{InputError, Known, Measurement};
 use rotorid::simulate::TimeResponse;
 use rotorid::{Rotor, SpeedState};
 
@@ -37,13 +38,13 @@ fn known_comes_from_the_rotor() {
 
 #[test]
 fn bad_construction_inputs_name_the_field() {
-    let cases: Vec<(Result<AlgebraicIdentifier, IdentifyError>, &str)> = vec![
+    let cases: Vec<(Result<AlgebraicIdentifier, AlgebraicError>, &str)> = vec![
         (
-            AlgebraicIdentifier::new(known(), 0.0, IdentifierConfig::default()),
+            AlgebraicIdentifier::new(known(), 0.0, AlgebraicConfig::default()),
             "dt = 0 is out of range: must be finite and > 0 (s)",
         ),
         (
-            AlgebraicIdentifier::new(known(), f64::NAN, IdentifierConfig::default()),
+            AlgebraicIdentifier::new(known(), f64::NAN, AlgebraicConfig::default()),
             "dt = NaN",
         ),
         (
@@ -53,7 +54,7 @@ fn bad_construction_inputs_name_the_field() {
                     ..known()
                 },
                 1e-4,
-                IdentifierConfig::default(),
+                AlgebraicConfig::default(),
             ),
             "known.a = inf",
         ),
@@ -64,7 +65,7 @@ fn bad_construction_inputs_name_the_field() {
                     ..known()
                 },
                 1e-4,
-                IdentifierConfig::default(),
+                AlgebraicConfig::default(),
             ),
             "known.mud = NaN",
         ),
@@ -75,7 +76,7 @@ fn bad_construction_inputs_name_the_field() {
                     ..known()
                 },
                 1e-4,
-                IdentifierConfig::default(),
+                AlgebraicConfig::default(),
             ),
             "known.alpha",
         ),
@@ -83,7 +84,7 @@ fn bad_construction_inputs_name_the_field() {
             AlgebraicIdentifier::new(
                 known(),
                 1e-4,
-                IdentifierConfig {
+                AlgebraicConfig {
                     rcond_min: 2.0,
                     ..Default::default()
                 },
@@ -94,7 +95,7 @@ fn bad_construction_inputs_name_the_field() {
             AlgebraicIdentifier::new(
                 known(),
                 1e-4,
-                IdentifierConfig {
+                AlgebraicConfig {
                     speed_model: SpeedModel::Constant {
                         omega: f64::NAN,
                         phi0: 0.0,
@@ -112,8 +113,8 @@ fn bad_construction_inputs_name_the_field() {
             "{msg:?} does not start with {want:?}"
         );
     }
-    assert!(IdentifierConfig::new(Quadrature::Trapezoid, -1e-3, SpeedModel::General).is_err());
-    assert!(IdentifierConfig::constant_speed(125.0, f64::INFINITY).is_err());
+    assert!(AlgebraicConfig::new(Quadrature::Trapezoid, -1e-3, SpeedModel::General).is_err());
+    assert!(AlgebraicConfig::constant_speed(125.0, f64::INFINITY).is_err());
     assert!(ConvergenceTracker::new(-0.1, 1e-5).is_err());
     assert!(ConvergenceTracker::new(0.01, f64::NAN).is_err());
     assert!(ConvergenceTracker::with_capacity(0.01, 1e-5, 1).is_err());
@@ -121,7 +122,7 @@ fn bad_construction_inputs_name_the_field() {
 
 #[test]
 fn non_finite_measurements_name_the_field_and_change_nothing() {
-    let mut id = AlgebraicIdentifier::new(known(), 1e-4, IdentifierConfig::default()).unwrap();
+    let mut id = AlgebraicIdentifier::new(known(), 1e-4, AlgebraicConfig::default()).unwrap();
     let mut reference = id.clone();
     for i in 0..10 {
         id.push(&sample(i)).unwrap();
@@ -140,7 +141,7 @@ fn non_finite_measurements_name_the_field_and_change_nothing() {
         let mut m = sample(10);
         poison(&mut m);
         match id.push(&m) {
-            Err(IdentifyError::NotFinite { index, field, .. }) => {
+            Err(AlgebraicError::Input(InputError::NotFinite { index, field, .. })) => {
                 assert_eq!(field, name);
                 assert_eq!(index, 10);
             }
@@ -167,7 +168,7 @@ fn non_finite_measurements_name_the_field_and_change_nothing() {
 
 #[test]
 fn constant_speed_mode_ignores_the_speed_fields() {
-    let config = IdentifierConfig::constant_speed(125.0, 0.0).unwrap();
+    let config = AlgebraicConfig::constant_speed(125.0, 0.0).unwrap();
     let mut id = AlgebraicIdentifier::new(known(), 1e-4, config).unwrap();
     for i in 0..5 {
         let mut m = sample(i);
@@ -182,13 +183,16 @@ fn constant_speed_mode_ignores_the_speed_fields() {
     m.z = f64::NAN;
     assert!(matches!(
         id.push(&m),
-        Err(IdentifyError::NotFinite { field: "z", .. })
+        Err(AlgebraicError::Input(InputError::NotFinite {
+            field: "z",
+            ..
+        }))
     ));
 }
 
 #[test]
 fn non_uniform_or_backward_time_is_rejected_with_the_tolerance() {
-    let mut id = AlgebraicIdentifier::new(known(), 1e-4, IdentifierConfig::default()).unwrap();
+    let mut id = AlgebraicIdentifier::new(known(), 1e-4, AlgebraicConfig::default()).unwrap();
     for i in 0..3 {
         id.push(&sample(i)).unwrap();
     }
@@ -200,13 +204,13 @@ fn non_uniform_or_backward_time_is_rejected_with_the_tolerance() {
         let mut m = sample(4);
         m.t = bad_t;
         match id.push(&m) {
-            Err(IdentifyError::NonUniformSampling {
+            Err(AlgebraicError::Input(InputError::NonUniformSampling {
                 index,
                 t,
                 expected,
                 tolerance,
                 dt,
-            }) => {
+            })) => {
                 assert_eq!(index, 4);
                 assert_eq!(t, bad_t);
                 assert!((expected - (4e-4 + 1e-11)).abs() < 1e-15);
@@ -225,7 +229,7 @@ fn non_uniform_or_backward_time_is_rejected_with_the_tolerance() {
     );
     assert!(msg.contains("1e-6 dt + 8 ulp(t)"), "{msg}");
     // a large absolute time base is fine (tau is counted from the first sample)
-    let mut id = AlgebraicIdentifier::new(known(), 1e-4, IdentifierConfig::default()).unwrap();
+    let mut id = AlgebraicIdentifier::new(known(), 1e-4, AlgebraicConfig::default()).unwrap();
     let t0 = 1.7e9;
     for i in 0..50 {
         let mut m = sample(i);
@@ -236,13 +240,13 @@ fn non_uniform_or_backward_time_is_rejected_with_the_tolerance() {
 
 #[test]
 fn the_first_sample_and_singular_systems_are_nan_not_errors() {
-    let mut id = AlgebraicIdentifier::new(known(), 1e-4, IdentifierConfig::default()).unwrap();
+    let mut id = AlgebraicIdentifier::new(known(), 1e-4, AlgebraicConfig::default()).unwrap();
     let e = id.push(&sample(0)).unwrap();
     assert!(e.x.m.is_nan() && e.z.k.is_nan());
     assert_eq!((e.x.rcond, e.z.rcond), (0.0, 0.0));
     assert_eq!(e.well_conditioned(0.0), [false, false]);
     // All-zero data: A = 0 forever; NaN, rcond = 0, no error, no panic.
-    let mut id = AlgebraicIdentifier::new(known(), 1e-4, IdentifierConfig::default()).unwrap();
+    let mut id = AlgebraicIdentifier::new(known(), 1e-4, AlgebraicConfig::default()).unwrap();
     for i in 0..100 {
         let m = Measurement {
             t: i as f64 * 1e-4,
@@ -256,11 +260,11 @@ fn the_first_sample_and_singular_systems_are_nan_not_errors() {
 
 #[test]
 fn records_are_checked() {
-    let config = IdentifierConfig::default();
+    let config = AlgebraicConfig::default();
     let mut r = TimeResponse::default();
     assert_eq!(
         identify_response(&r, known(), config).unwrap_err(),
-        IdentifyError::TooFewSamples { samples: 0 }
+        AlgebraicError::Input(InputError::TooFewSamples { samples: 0 })
     );
     r.t = vec![0.0, 1e-4];
     r.x = vec![0.0; 2];
@@ -271,11 +275,11 @@ fn records_are_checked() {
     let e = identify_response(&r, known(), config).unwrap_err();
     assert_eq!(
         e,
-        IdentifyError::ColumnLength {
+        AlgebraicError::Input(InputError::ColumnLength {
             column: "z",
             len: 1,
             expected: 2
-        }
+        })
     );
     r.z = vec![0.0; 2];
     assert_eq!(identify_response(&r, known(), config).unwrap().len(), 2);
@@ -287,7 +291,10 @@ fn records_are_checked() {
     bad[3].t = 1.0;
     assert!(matches!(
         identify_batch(&bad, known(), 1e-4, config),
-        Err(IdentifyError::NonUniformSampling { index: 3, .. })
+        Err(AlgebraicError::Input(InputError::NonUniformSampling {
+            index: 3,
+            ..
+        }))
     ));
     assert!("simpson".parse::<Quadrature>().is_err());
 }

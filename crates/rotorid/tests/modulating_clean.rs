@@ -1,11 +1,13 @@
 //! The modulating-function identifier on exact (noise-free) data: accuracy, independence
 //! of the initial state, observed quadrature order, streaming = batch, input errors.
 
+use rotorid::identify::algebraic::measurement;
 use rotorid::identify::modulating::{
     identify_modulating, identify_modulating_response, ModulatingConfig, ModulatingDirection,
     ModulatingError, ModulatingEstimate, ModulatingIdentifier, NoiseCompensation,
 };
-use rotorid::identify::{measurement, IdentifyError, Known};
+use rotorid::identify::InputError;
+use rotorid::identify::Known;
 use rotorid::model::OutOfRange;
 use rotorid::simulate::{simulate, Method, TimeResponse};
 use rotorid::{InitialState, Sampling, Scenario};
@@ -224,7 +226,7 @@ fn bad_inputs_are_reported_with_their_values() {
     assert!(
         matches!(
             e,
-            ModulatingError::Input(IdentifyError::ColumnLength { column: "x", .. })
+            ModulatingError::Input(InputError::ColumnLength { column: "x", .. })
         ),
         "{e}"
     );
@@ -234,7 +236,7 @@ fn bad_inputs_are_reported_with_their_values() {
     assert!(
         matches!(
             e,
-            ModulatingError::Input(IdentifyError::NotFinite {
+            ModulatingError::Input(InputError::NotFinite {
                 index: 321,
                 field: "x",
                 ..
@@ -248,7 +250,7 @@ fn bad_inputs_are_reported_with_their_values() {
     assert!(
         matches!(
             e,
-            ModulatingError::Input(IdentifyError::NonUniformSampling { index: 400, .. })
+            ModulatingError::Input(InputError::NonUniformSampling { index: 400, .. })
         ),
         "{e}"
     );
@@ -311,7 +313,7 @@ fn bad_inputs_are_reported_with_their_values() {
         ),
     ] {
         match call(&r.t, &r.x, bad).unwrap_err() {
-            ModulatingError::Input(IdentifyError::OutOfRange(OutOfRange {
+            ModulatingError::Input(InputError::OutOfRange(OutOfRange {
                 field: f,
                 allowed,
                 ..

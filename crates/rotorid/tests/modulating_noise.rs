@@ -2,10 +2,11 @@
 //! sampling): far better than the plain algebraic identifier, standard errors that match
 //! the scatter, and a noise bias that the compensation removes.
 
+use rotorid::identify::algebraic::{identify_response, AlgebraicConfig};
 use rotorid::identify::modulating::{
     identify_modulating_response, ModulatingConfig, ModulatingEstimate, NoiseCompensation,
 };
-use rotorid::identify::{identify_response, IdentifierConfig, Known};
+use rotorid::identify::Known;
 use rotorid::simulate::{add_noise, simulate, Method, TimeResponse};
 use rotorid::{Sampling, Scenario};
 
@@ -57,7 +58,7 @@ fn at_40_db_over_one_second_it_is_orders_of_magnitude_better_than_the_plain_iden
                 &modulating(&s, &r, ModulatingConfig::default()).values(),
             );
             // the plain identifier at the last well-conditioned instant
-            let cfg = IdentifierConfig::default();
+            let cfg = AlgebraicConfig::default();
             let est = identify_response(&r, known, cfg).unwrap();
             let last = est
                 .iter()

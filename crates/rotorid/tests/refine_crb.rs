@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, DVector};
 use rotorid::model::{InitialState, RotorParams, Sampling, Scenario};
-use rotorid::refine::{crb, crb_at_snr, model_response, Experiment, Integrator, Unknowns};
+use rotorid::refine::{crb, crb_at_snr, model_response, Discretisation, Experiment, Unknowns};
 
 const NAMES: [&str; 5] = ["m", "cx", "kx", "cz", "kz"];
 
@@ -86,7 +86,7 @@ fn short_records_initial_state_known() {
         &full.rotor.params(),
         &full.initial,
         &Experiment::from_scenario(&full),
-        Integrator::Auto,
+        Discretisation::Auto,
     )
     .unwrap();
     let (sx, sz) = (rms(&clean.x) * 0.01, rms(&clean.z) * 0.01);
@@ -152,7 +152,7 @@ fn fisher_by_finite_differences(
         let run = |sign: f64| {
             let (mut q, mut y) = (*p, InitialState::default());
             set(&mut q, &mut y, sign * h);
-            model_response(&q, &y, exp, Integrator::Auto).unwrap()
+            model_response(&q, &y, exp, Discretisation::Auto).unwrap()
         };
         let (plus, minus) = (run(1.0), run(-1.0));
         for k in 0..n {

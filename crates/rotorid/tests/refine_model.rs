@@ -2,7 +2,7 @@
 //! error must be far below the noise (relative Cramer-Rao bound ~4e-5 for m at 40 dB).
 
 use rotorid::model::{InitialState, Rotor, Sampling, Scenario, SpeedProfile};
-use rotorid::refine::{model_response, Experiment, Integrator, SpeedData};
+use rotorid::refine::{model_response, Discretisation, Experiment, SpeedData};
 use rotorid::simulate::{simulate, Method};
 
 fn max_abs(v: &[f64]) -> f64 {
@@ -39,7 +39,7 @@ fn exact_discretisation_matches_the_reference_at_constant_speed() {
     let s = scenario_with_initial(Scenario::table1());
     let reference = simulate(&s, Method::Exact).unwrap();
     let exp = Experiment::from_scenario(&s);
-    let m = model_response(&s.rotor.params(), &s.initial, &exp, Integrator::Auto).unwrap();
+    let m = model_response(&s.rotor.params(), &s.initial, &exp, Discretisation::Auto).unwrap();
     assert!(m.discretisation.starts_with("exact"));
     let e = rel_err((&m.x, &m.z), (&reference.x, &reference.z));
     println!("exact vs simulate::Exact, 1200 rpm, 1 s: {e:.2e}");
@@ -53,9 +53,10 @@ fn rk4_matches_the_reference_on_a_ramp() {
         let reference = simulate(&s, Method::Exact).unwrap();
         let exp = Experiment::from_scenario(&s);
         let p = s.rotor.params();
-        let auto = model_response(&p, &s.initial, &exp, Integrator::Auto).unwrap();
+        let auto = model_response(&p, &s.initial, &exp, Discretisation::Auto).unwrap();
         let e_auto = rel_err((&auto.x, &auto.z), (&reference.x, &reference.z));
-        let one = model_response(&p, &s.initial, &exp, Integrator::Rk4 { substeps: 1 }).unwrap();
+        let one =
+            model_response(&p, &s.initial, &exp, Discretisation::Rk4 { substeps: 1 }).unwrap();
         let e_one = rel_err((&one.x, &one.z), (&reference.x, &reference.z));
         println!(
             "ramp from {rpm0} rpm, 1 s: {} -> {e_auto:.2e}; 1 sub-step -> {e_one:.2e}",
@@ -74,8 +75,8 @@ fn rk4_and_exact_agree_at_constant_speed() {
     let s = scenario_with_initial(Scenario::table1());
     let exp = Experiment::from_scenario(&s);
     let p = s.rotor.params();
-    let exact = model_response(&p, &s.initial, &exp, Integrator::Exact).unwrap();
-    let rk4 = model_response(&p, &s.initial, &exp, Integrator::Rk4 { substeps: 0 }).unwrap();
+    let exact = model_response(&p, &s.initial, &exp, Discretisation::Exact).unwrap();
+    let rk4 = model_response(&p, &s.initial, &exp, Discretisation::Rk4 { substeps: 0 }).unwrap();
     let e = rel_err((&rk4.x, &rk4.z), (&exact.x, &exact.z));
     println!("RK4 (auto) vs exact at 1200 rpm: {e:.2e}");
     assert!(e < 1e-7, "{e:e}");
@@ -104,8 +105,8 @@ fn measured_speed_samples_give_the_profile_response() {
         ..exp
     };
     let p = s.rotor.params();
-    let a = model_response(&p, &s.initial, &exp, Integrator::Auto).unwrap();
-    let b = model_response(&p, &s.initial, &sampled, Integrator::Auto).unwrap();
+    let a = model_response(&p, &s.initial, &exp, Discretisation::Auto).unwrap();
+    let b = model_response(&p, &s.initial, &sampled, Discretisation::Auto).unwrap();
     let e = rel_err((&b.x, &b.z), (&a.x, &a.z));
     assert!(e < 1e-10, "{e:e}");
 }
@@ -114,7 +115,7 @@ fn measured_speed_samples_give_the_profile_response() {
 fn exact_is_refused_for_a_ramp() {
     let s = Scenario::table1_ramp(600.0).unwrap();
     let exp = Experiment::from_scenario(&s);
-    let e = model_response(&s.rotor.params(), &s.initial, &exp, Integrator::Exact).unwrap_err();
+    let e = model_response(&s.rotor.params(), &s.initial, &exp, Discretisation::Exact).unwrap_err();
     assert!(e.to_string().contains("constant speed"), "{e}");
 }
 
@@ -129,8 +130,8 @@ fn coarse_sampling_uses_more_substeps_and_stays_accurate() {
     };
     let exp = Experiment::from_scenario(&s);
     let p = s.rotor.params();
-    let exact = model_response(&p, &s.initial, &exp, Integrator::Exact).unwrap();
-    let rk4 = model_response(&p, &s.initial, &exp, Integrator::Rk4 { substeps: 0 }).unwrap();
+    let exact = model_response(&p, &s.initial, &exp, Discretisation::Exact).unwrap();
+    let rk4 = model_response(&p, &s.initial, &exp, Discretisation::Rk4 { substeps: 0 }).unwrap();
     let e = rel_err((&rk4.x, &rk4.z), (&exact.x, &exact.z));
     println!("{} at 1 kHz: {e:.2e}", rk4.discretisation);
     assert!(rk4.discretisation.contains("17 sub-step"));

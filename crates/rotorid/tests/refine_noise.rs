@@ -129,7 +129,8 @@ fn hundred_seeds_efficiency_bias_and_coverage() {
 /// the truth.
 #[test]
 fn algebraic_start_reaches_the_same_optimum() {
-    use rotorid::identify::{identify_response, IdentifierConfig, Known};
+    use rotorid::identify::algebraic::{identify_response, AlgebraicConfig};
+    use rotorid::identify::Known;
     for s in [Scenario::table1(), Scenario::table1_ramp(600.0).unwrap()] {
         let clean = simulate(&s, Method::Exact).unwrap();
         let truth = s.rotor.params();
@@ -139,7 +140,7 @@ fn algebraic_start_reaches_the_same_optimum() {
             let est = identify_response(
                 &resp,
                 Known::from_rotor(&s.rotor),
-                IdentifierConfig::default(),
+                AlgebraicConfig::default(),
             )
             .unwrap();
             let e = est[500];

@@ -12,11 +12,12 @@
 
 use std::fmt::Write as _;
 
-use rotorid::identify::{
-    identify_response, ConvergenceTracker, IdentifierConfig, Known, Parameter, Quadrature,
-    DEFAULT_TOLERANCE,
+use rotorid::identify::algebraic::{
+    identify_response, AlgebraicConfig, ConvergenceTracker, Quadrature, DEFAULT_TOLERANCE,
 };
+use rotorid::identify::Known;
 use rotorid::simulate::{simulate, Method};
+use rotorid::Parameter;
 use rotorid::Scenario;
 use serde::Serialize;
 
@@ -141,9 +142,9 @@ pub fn compute() -> anyhow::Result<DemoReport> {
         let mut out = Vec::new();
         for (name, sc) in &cases {
             let resp = simulate(sc, method)?;
-            let config = IdentifierConfig {
+            let config = AlgebraicConfig {
                 quadrature,
-                ..IdentifierConfig::default()
+                ..AlgebraicConfig::default()
             };
             let estimates = identify_response(&resp, Known::from_rotor(&sc.rotor), config)?;
             let mut tracker = ConvergenceTracker::new(tol, config.rcond_min)?;
@@ -156,9 +157,12 @@ pub fn compute() -> anyhow::Result<DemoReport> {
                 .results()
                 .iter()
                 .map(|c| {
-                    let t = truth[c.parameter.index()];
+                    let t = truth[c
+                        .parameter
+                        .direction_index()
+                        .expect("the tracker follows per-direction parameters")];
                     DemoRow {
-                        parameter: c.parameter.name(),
+                        parameter: c.parameter.column(),
                         unit: c.parameter.unit(),
                         truth: t,
                         identified: c.final_value,

@@ -28,7 +28,7 @@ mod speed;
 mod start;
 
 use anyhow::Context as _;
-use rotorid::identify::Quadrature;
+use rotorid::identify::algebraic::Quadrature;
 
 use crate::io::{
     is_broken_pipe, open_input, EstimateRow, EstimatesWriter, FileMode, FlushBeforeRead, Output,
@@ -37,8 +37,8 @@ use crate::io::{
 
 // The defaults shown in `--help`, each written once (a test keeps them equal to the
 // library's constants): the algebraic identifier's calibrated
-// `rotorid::identify::DEFAULT_RCOND_MIN`, the modulating identifier's
-// `modulating::DEFAULT_RCOND_MIN` and `DEFAULT_WINDOW_S`, `rotorid::identify::DEFAULT_TOLERANCE`,
+// `rotorid::identify::algebraic::DEFAULT_ALGEBRAIC_RCOND_MIN`, the modulating identifier's
+// `modulating::DEFAULT_MODULATING_RCOND_MIN` and `DEFAULT_WINDOW_S`, `rotorid::identify::algebraic::DEFAULT_TOLERANCE`,
 // `Quadrature::default()` and `crate::io::DEFAULT_TIME_TOLERANCE`.
 macro_rules! rcond_min_text {
     () => {
@@ -343,7 +343,7 @@ pub(crate) struct Context<'a> {
 }
 
 fn check_args(args: &IdentifyArgs) -> anyhow::Result<Settings> {
-    use rotorid::identify::modulating::{DEFAULT_RCOND_MIN, DEFAULT_WINDOW_S};
+    use rotorid::identify::modulating::{DEFAULT_MODULATING_RCOND_MIN, DEFAULT_WINDOW_S};
     let ok = |v: f64| v.is_finite() && v >= 0.0;
     let method = args.method;
     let only = |flag: &str, given: bool, allowed: &[IdentifyMethod]| -> anyhow::Result<()> {
@@ -367,7 +367,9 @@ fn check_args(args: &IdentifyArgs) -> anyhow::Result<Settings> {
     )?;
     only("--window", args.window.is_some(), &[Modulating, Refine])?;
     only("--unknowns", args.unknowns.is_some(), &[Refine])?;
-    let tol = args.tol.unwrap_or(rotorid::identify::DEFAULT_TOLERANCE);
+    let tol = args
+        .tol
+        .unwrap_or(rotorid::identify::algebraic::DEFAULT_TOLERANCE);
     if !ok(tol) {
         anyhow::bail!("--tol = {tol} is out of range: must be finite and >= 0 (relative)");
     }
@@ -392,8 +394,8 @@ fn check_args(args: &IdentifyArgs) -> anyhow::Result<Settings> {
         tol,
         rcond_min_algebraic: args
             .rcond_min
-            .unwrap_or(rotorid::identify::DEFAULT_RCOND_MIN),
-        rcond_min_modulating: args.rcond_min.unwrap_or(DEFAULT_RCOND_MIN),
+            .unwrap_or(rotorid::identify::algebraic::DEFAULT_ALGEBRAIC_RCOND_MIN),
+        rcond_min_modulating: args.rcond_min.unwrap_or(DEFAULT_MODULATING_RCOND_MIN),
         window_s,
     })
 }
@@ -473,11 +475,11 @@ mod tests {
         use rotorid::identify::modulating;
         assert_eq!(
             RCOND_MIN_TEXT.parse::<f64>().unwrap(),
-            rotorid::identify::DEFAULT_RCOND_MIN
+            rotorid::identify::algebraic::DEFAULT_ALGEBRAIC_RCOND_MIN
         );
         assert_eq!(
             MODULATING_RCOND_MIN_TEXT.parse::<f64>().unwrap(),
-            modulating::DEFAULT_RCOND_MIN
+            modulating::DEFAULT_MODULATING_RCOND_MIN
         );
         assert_eq!(
             TIME_TOLERANCE_TEXT.parse::<f64>().unwrap(),
@@ -485,7 +487,7 @@ mod tests {
         );
         assert_eq!(
             TOL_TEXT.parse::<f64>().unwrap(),
-            rotorid::identify::DEFAULT_TOLERANCE
+            rotorid::identify::algebraic::DEFAULT_TOLERANCE
         );
         assert_eq!(
             WINDOW_TEXT.parse::<f64>().unwrap(),

@@ -19,7 +19,10 @@
 //! config)`: one estimate theta(t) = (m, c, k) per direction and sample, with its rcond.
 
 use anyhow::Context;
-use rotorid::identify::{identify_response, Estimate, IdentifierConfig, Known, Quadrature};
+use rotorid::identify::algebraic::{
+    identify_response, AlgebraicConfig, AlgebraicEstimate, Quadrature,
+};
+use rotorid::identify::Known;
 use rotorid::simulate::{simulate, Method, TimeResponse};
 use rotorid::{Sampling, Scenario, SpeedProfile};
 
@@ -154,14 +157,12 @@ impl Setting {
 
     /// The identifier configuration for `scenario` (the constant-speed identifier at
     /// constant speed, the general one otherwise).
-    pub fn config(self, scenario: &Scenario) -> anyhow::Result<IdentifierConfig> {
+    pub fn config(self, scenario: &Scenario) -> anyhow::Result<AlgebraicConfig> {
         let base = match scenario.speed {
-            SpeedProfile::Constant { omega, phi0 } => {
-                IdentifierConfig::constant_speed(omega, phi0)?
-            }
-            _ => IdentifierConfig::default(),
+            SpeedProfile::Constant { omega, phi0 } => AlgebraicConfig::constant_speed(omega, phi0)?,
+            _ => AlgebraicConfig::default(),
         };
-        Ok(IdentifierConfig {
+        Ok(AlgebraicConfig {
             quadrature: self.quadrature(),
             ..base
         })
@@ -178,11 +179,11 @@ pub struct Run {
     /// The scenario simulated (its rotor holds the true values).
     pub scenario: Scenario,
     /// The identifier's settings.
-    pub config: IdentifierConfig,
+    pub config: AlgebraicConfig,
     /// The simulated response (t [s], x, z [m], phi [rad], w [rad/s], w' [rad/s^2]).
     pub response: TimeResponse,
     /// One estimate per sample.
-    pub estimates: Vec<Estimate>,
+    pub estimates: Vec<AlgebraicEstimate>,
 }
 
 /// Simulate and identify `case` in `setting` over `duration` seconds.

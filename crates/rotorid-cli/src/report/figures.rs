@@ -13,10 +13,10 @@
 //! at a glance. Estimates at ill-conditioned instants (rcond < rcond_min) are drawn but
 //! ignored when scaling y, and y never extends beyond +-50 % of the true value.
 
-use rotorid::identify::Parameter;
+use rotorid::Parameter;
 
 use super::experiment::{Case, Run, Setting};
-use super::results::{symbol, true_value, well_conditioned};
+use super::results::{index, symbol, true_value, well_conditioned};
 use crate::plot::scale::si_prefix;
 use crate::plot::{palette, Figure, Panel, Series};
 
@@ -161,7 +161,7 @@ fn quantity(sym: &str) -> (&'static str, &'static str) {
 fn parameter_figure(number: u32, full: bool, sym: &str, paper: &Run, ours: &Run) -> PaperFigure {
     let duration = ours.scenario.sampling.duration();
     let (px, pz) = match sym {
-        "m" => (Parameter::Mx, Parameter::Mz),
+        "m" => (Parameter::MX, Parameter::MZ),
         "c" => (Parameter::Cx, Parameter::Cz),
         _ => (Parameter::Kx, Parameter::Kz),
     };
@@ -173,7 +173,7 @@ fn parameter_figure(number: u32, full: bool, sym: &str, paper: &Run, ours: &Run)
         let values = |p: Parameter| {
             run.estimates
                 .iter()
-                .map(|e| e.values()[p.index()])
+                .map(|e| e.values()[index(p)])
                 .collect::<Vec<f64>>()
         };
         let (sx, sz) = if sym == "m" {

@@ -9,12 +9,13 @@
 //!
 //! with tol = 1 %. T measures convergence to the TRUE value (the paper's "tiempo de
 //! identificación"); `settling_time` is the identifier's own answer without the truth
-//! ([`rotorid::identify::ConvergenceTracker`]: within 1 % of its final value). Instants
+//! ([`rotorid::identify::algebraic::ConvergenceTracker`]: within 1 % of its final value). Instants
 //! with rcond < rcond_min are not estimates and are skipped by both (method.md section 6).
 //! Paper's claims (Barredo et al. 2024, "Resultados"): constant speed, all parameters in
 //! < 0.2 s; ramp, m and k in < 0.1 s and c in < 0.28 s.
 
-use rotorid::identify::{ConvergenceTracker, Parameter};
+use rotorid::identify::algebraic::ConvergenceTracker;
+use rotorid::Parameter;
 use serde::Serialize;
 
 use super::experiment::{Run, PAPER_DT};
@@ -121,28 +122,34 @@ pub fn attribution(run: &Run) -> Attribution {
     }
 }
 
+/// Position of the per-direction parameter `p` in an estimate's `values()`.
+pub fn index(p: Parameter) -> usize {
+    p.direction_index()
+        .expect("the paper's figures show the per-direction parameters only")
+}
+
 /// The true value of `p` for the rotor of `run`.
 pub fn true_value(run: &Run, p: Parameter) -> f64 {
     let r = &run.scenario.rotor;
-    [r.m(), r.cx(), r.kx(), r.m(), r.cz(), r.kz()][p.index()]
+    [r.m(), r.cx(), r.kx(), r.m(), r.cz(), r.kz()][index(p)]
 }
 
 /// `m`, `c` or `k`.
 pub fn symbol(p: Parameter) -> &'static str {
-    ["m", "c", "k"][p.index() % 3]
+    ["m", "c", "k"][index(p) % 3]
 }
 
 /// `x` or `z`.
 pub fn direction(p: Parameter) -> &'static str {
-    ["x", "z"][p.index() / 3]
+    ["x", "z"][index(p) / 3]
 }
 
 /// Well-conditioned flag of parameter `p` at every estimate of `run`.
 pub fn well_conditioned(run: &Run, p: Parameter) -> Vec<bool> {
-    let dir = p.index() / 3;
+    let dir = index(p) / 3;
     run.estimates
         .iter()
-        .map(|e| e.well_conditioned(run.config.rcond_min)[dir] && e.values()[p.index()].is_finite())
+        .map(|e| e.well_conditioned(run.config.rcond_min)[dir] && e.values()[index(p)].is_finite())
         .collect()
 }
 
@@ -195,14 +202,10 @@ pub fn rows(run: &Run) -> Vec<Row> {
     }
     // the sample at 0.3 s, with slack for the exact grid t_i = i dt
     let t_read = ESTIMATE_TIME + 0.5 * PAPER_DT;
-    Parameter::ALL
+    Parameter::PER_DIRECTION
         .iter()
         .map(|&p| {
-            let v: Vec<f64> = run
-                .estimates
-                .iter()
-                .map(|e| e.values()[p.index()])
-                .collect();
+            let v: Vec<f64> = run.estimates.iter().map(|e| e.values()[index(p)]).collect();
             let ok = well_conditioned(run, p);
             let truth = true_value(run, p);
             let at = (0..t.len()).rev().find(|&i| ok[i] && t[i] <= t_read);
@@ -214,7 +217,7 @@ pub fn rows(run: &Run) -> Vec<Row> {
                 setting: run.setting.name(),
                 parameter: symbol(p),
                 direction: direction(p),
-                name: p.name(),
+                name: p.column(),
                 unit: p.unit(),
                 true_value: truth,
                 estimate,
@@ -223,7 +226,7 @@ pub fn rows(run: &Run) -> Vec<Row> {
                     .filter(|_| truth != 0.0)
                     .map(|e| (e - truth) / truth),
                 identification_time,
-                settling_time: tracker.result(p).identification_time,
+                settling_time: tracker.result(p).and_then(|c| c.identification_time),
                 paper_time,
                 within_paper_time: identification_time.is_some_and(|ti| ti <= paper_time),
                 outside_after_paper_time: fraction_outside(

@@ -1,12 +1,14 @@
-//! Errors of the identifiers. Each variant carries the offending value, sample or name, and
-//! its message states what is allowed, so a user can fix the input without reading code.
-//! A singular or ill-conditioned system is NOT an error (the estimate is NaN / flagged).
+//! Errors in what every identifier takes: a configuration value out of range, a sample that is
+//! not finite or off the uniform grid, record columns of unequal length. Each variant carries
+//! the offending value, sample or name, and its message states what is allowed, so a user can
+//! fix the input without reading code. Each method wraps it in its own error type
+//! ([`super::algebraic::AlgebraicError`], [`super::modulating::ModulatingError`]).
 
 use crate::model::OutOfRange;
 
 /// Why an identifier could not be built or could not take a measurement.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum IdentifyError {
+pub enum InputError {
     /// A configuration value or known quantity (e.g. `dt`, `rcond_min`, `known.a`) is
     /// outside its allowed range (this includes NaN and infinity).
     #[error(transparent)]
@@ -56,11 +58,5 @@ pub enum IdentifyError {
         len: usize,
         /// The length of `t`.
         expected: usize,
-    },
-    /// A quadrature name that is not known.
-    #[error("unknown quadrature {name:?}: expected \"trapezoid\", \"am3\", \"am4\" or \"am5\"")]
-    UnknownQuadrature {
-        /// The name as given.
-        name: String,
     },
 }

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::error::IdentifyError;
+use super::error::InputError;
 use crate::model::{check, Rotor, SpeedState};
 
 /// The quantities the identifiers take as known (method.md section 4).
@@ -30,7 +30,7 @@ impl Known {
     }
 
     /// Every field finite.
-    pub fn validated(self) -> Result<Self, IdentifyError> {
+    pub fn validated(self) -> Result<Self, InputError> {
         check("known.a", self.a, "finite (N s^2/m)", |_| true)?;
         check("known.mud", self.mud, "finite (kg m)", |_| true)?;
         check("known.alpha", self.alpha, "finite (rad)", |_| true)?;

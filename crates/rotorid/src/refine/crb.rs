@@ -12,7 +12,7 @@
 
 use crate::model::{check, InitialState, RotorParams, Scenario};
 
-use super::discretisation::{Discrete, Integrator};
+use super::discretisation::{Discrete, Discretisation};
 use super::error::RefineError;
 use super::fisher::Fisher;
 use super::record::Experiment;
@@ -42,7 +42,7 @@ pub fn crb(
         return Err(RefineError::NoUnknowns);
     }
     let t = Theta::new(rotor, initial);
-    let disc = Discrete::new(experiment, Integrator::Auto, &t)?;
+    let disc = Discrete::new(experiment, Discretisation::Auto, &t)?;
     let mut sink = NormalSink {
         data: None,
         acc: Normal::new(cols.n),
@@ -96,7 +96,7 @@ pub fn crb_at_snr(
     check("snr_db", snr_db, "finite (dB)", |_| true)?;
     let exp = Experiment::from_scenario(scenario);
     let rotor = scenario.rotor.params();
-    let clean = model_response(&rotor, &scenario.initial, &exp, Integrator::Auto)?;
+    let clean = model_response(&rotor, &scenario.initial, &exp, Discretisation::Auto)?;
     let factor = 10f64.powf(-snr_db / 20.0);
     crb(
         &rotor,
@@ -125,13 +125,13 @@ pub fn model_response(
     rotor: &RotorParams,
     initial: &InitialState,
     experiment: &Experiment,
-    integrator: Integrator,
+    discretisation: Discretisation,
 ) -> Result<ModelResponse, RefineError> {
     experiment.validate()?;
     check_params(rotor)?;
     initial.validated()?;
     let t = Theta::new(rotor, initial);
-    let disc = Discrete::new(experiment, integrator, &t)?;
+    let disc = Discrete::new(experiment, discretisation, &t)?;
     let cols = Columns::new(&Unknowns {
         m: false,
         cx: false,

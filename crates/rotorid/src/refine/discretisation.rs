@@ -15,7 +15,7 @@ use super::unknowns::{Columns, Theta};
 
 /// How the model is discretised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum Integrator {
+pub enum Discretisation {
     /// Exact discretisation when the speed is an analytic constant profile, else RK4 with
     /// the automatic number of sub-steps.
     #[default]
@@ -48,21 +48,23 @@ impl Discrete {
     /// Tabulate the forcing for `exp`; `t` sets the automatic RK4 sub-step count.
     pub(crate) fn new(
         exp: &Experiment,
-        integrator: Integrator,
+        discretisation: Discretisation,
         t: &Theta,
     ) -> Result<Self, RefineError> {
         let constant = exp.speed.constant();
-        match (integrator, constant) {
-            (Integrator::Auto | Integrator::Exact, Some((omega, phi0))) => Ok(Discrete::Exact {
-                omega,
-                dt: exp.dt,
-                osc: oscillator_table(omega, phi0, exp.dt, exp.samples),
-            }),
-            (Integrator::Exact, None) => {
+        match (discretisation, constant) {
+            (Discretisation::Auto | Discretisation::Exact, Some((omega, phi0))) => {
+                Ok(Discrete::Exact {
+                    omega,
+                    dt: exp.dt,
+                    osc: oscillator_table(omega, phi0, exp.dt, exp.samples),
+                })
+            }
+            (Discretisation::Exact, None) => {
                 Err(RefineError::ExactNeedsConstantSpeed(exp.speed.describe()))
             }
-            (Integrator::Auto, None) => Ok(Self::rk4(exp, 0, t)),
-            (Integrator::Rk4 { substeps }, _) => Ok(Self::rk4(exp, substeps, t)),
+            (Discretisation::Auto, None) => Ok(Self::rk4(exp, 0, t)),
+            (Discretisation::Rk4 { substeps }, _) => Ok(Self::rk4(exp, substeps, t)),
         }
     }
 

@@ -48,7 +48,7 @@ pub enum RefineError {
     NoUnknowns,
     /// The exact (matrix-exponential) discretisation was requested for a speed that is
     /// not constant.
-    #[error("the exact discretisation needs a constant speed profile (got {0}); use Integrator::Auto or Integrator::Rk4")]
+    #[error("the exact discretisation needs a constant speed profile (got {0}); use Discretisation::Auto or Discretisation::Rk4")]
     ExactNeedsConstantSpeed(&'static str),
     /// The model description is invalid.
     #[error(transparent)]

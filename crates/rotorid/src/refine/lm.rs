@@ -40,11 +40,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::model::{check, InitialState, RotorParams};
 
-use super::discretisation::{Discrete, Integrator};
+use super::discretisation::{Discrete, Discretisation};
 use super::error::RefineError;
 use super::fisher::Fisher;
 use super::record::Record;
-use super::result::{identifiability_warnings, rows, Estimate, Refined, Warning, STD_ERROR_BASIS};
+use super::result::{
+    identifiability_warnings, rows, FittedValue, Refined, Warning, STD_ERROR_BASIS,
+};
 use super::steady::{steady_initial_state, TRANSIENT_SIGNIFICANCE};
 use super::sweep::{Normal, NormalSink};
 use super::unknowns::{check_params, Columns, Kind, Theta, Unknowns};
@@ -55,7 +57,7 @@ pub struct RefineOptions {
     /// What to estimate (default: m, cx, kx, cz, kz and the initial state).
     pub unknowns: Unknowns,
     /// The discrete model (default: exact at constant speed, RK4 otherwise).
-    pub integrator: Integrator,
+    pub discretisation: Discretisation,
     /// Most model passes (Levenberg-Marquardt trials, over all windows); 0 evaluates the
     /// start on the whole record (the initial state and unbalance, when unknown, still get
     /// their linear least-squares values).
@@ -69,7 +71,7 @@ impl Default for RefineOptions {
     fn default() -> Self {
         Self {
             unknowns: Unknowns::default(),
-            integrator: Integrator::Auto,
+            discretisation: Discretisation::Auto,
             max_iterations: 50,
             tolerance: 1e-3,
         }
@@ -363,7 +365,7 @@ pub fn refine(
     if options.unknowns.cz {
         theta.cz = theta.cz.max(0.0);
     }
-    let disc = Discrete::new(&record.experiment(), options.integrator, &theta)?;
+    let disc = Discrete::new(&record.experiment(), options.discretisation, &theta)?;
 
     let dt = record.dt;
     let mut n_used = if options.max_iterations == 0 {
@@ -525,7 +527,7 @@ fn assemble(
     let mut parameters = Vec::new();
     let mut initial_state = Vec::new();
     for (r, r0) in rs.iter().zip(&starts) {
-        let e = Estimate {
+        let e = FittedValue {
             name: r.name,
             unit: r.unit,
             value: r.value,

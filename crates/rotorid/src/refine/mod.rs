@@ -72,11 +72,11 @@ mod sweep;
 mod unknowns;
 
 pub use crb::{crb, crb_at_snr, model_response, ModelResponse};
-pub use discretisation::Integrator;
+pub use discretisation::Discretisation;
 pub use error::RefineError;
 pub use lm::{refine, RefineOptions};
 pub use record::{Experiment, Record, SpeedData};
 pub use result::{
-    Bound, Crb, Estimate, Refined, Warning, ALPHA_STD_LIMIT, CONDITION_LIMIT, STD_ERROR_BASIS,
+    Bound, Crb, FittedValue, Refined, Warning, ALPHA_STD_LIMIT, CONDITION_LIMIT, STD_ERROR_BASIS,
 };
 pub use unknowns::Unknowns;

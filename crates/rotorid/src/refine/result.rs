@@ -29,7 +29,7 @@ pub const ALPHA_STD_LIMIT: f64 = 1.0;
 
 /// One estimated quantity.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Estimate {
+pub struct FittedValue {
     /// Name: m, cx, kx, cz, kz, a, mud, alpha, x0, z0, vx0, vz0.
     pub name: &'static str,
     /// SI unit of `value` and `std_error` (kg, N s/m, N/m, N s^2/m, kg m, rad, m, m/s).
@@ -150,9 +150,9 @@ impl fmt::Display for Warning {
 pub struct Refined {
     /// The estimated model parameters, in the order m, cx, kx, cz, kz, a, mud, alpha
     /// (only those selected as unknown).
-    pub parameters: Vec<Estimate>,
+    pub parameters: Vec<FittedValue>,
     /// The estimated initial state x0, z0 \[m\], vx0, vz0 \[m/s\] (empty when it was known).
-    pub initial_state: Vec<Estimate>,
+    pub initial_state: Vec<FittedValue>,
     /// All rotor parameters: the estimates and the known values. The unbalance keeps the
     /// starting radius d (if > 0; else d = 1 m) with m_u = (m_u d) / d.
     pub rotor: RotorParams,
@@ -192,7 +192,7 @@ pub const STD_ERROR_BASIS: &str =
 
 impl Refined {
     /// The estimate called `name` (a parameter or an initial-state component).
-    pub fn get(&self, name: &str) -> Option<&Estimate> {
+    pub fn get(&self, name: &str) -> Option<&FittedValue> {
         self.parameters
             .iter()
             .chain(self.initial_state.iter())
@@ -214,7 +214,7 @@ impl Refined {
 /// One Cramer-Rao bound.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Bound {
-    /// Parameter name (as in [`Estimate::name`]).
+    /// Parameter name (as in [`FittedValue::name`]).
     pub name: &'static str,
     /// SI unit of `value` and `std_dev`.
     pub unit: &'static str,
@@ -262,7 +262,7 @@ impl Crb {
     }
 }
 
-/// A reported quantity before it is dressed as an [`Estimate`] or a [`Bound`].
+/// A reported quantity before it is dressed as a [`FittedValue`] or a [`Bound`].
 pub(crate) struct Row {
     pub name: &'static str,
     pub unit: &'static str,

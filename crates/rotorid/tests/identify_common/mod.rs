@@ -1,10 +1,12 @@
 //! Shared helpers of the identify_* integration tests.
 #![allow(dead_code)]
 
-use rotorid::identify::{
-    identify_response, Estimate, IdentifierConfig, Known, Parameter, Quadrature,
+use rotorid::identify::algebraic::{
+    identify_response, AlgebraicConfig, AlgebraicEstimate, Quadrature,
 };
+use rotorid::identify::Known;
 use rotorid::simulate::{simulate, Method, TimeResponse};
+use rotorid::Parameter;
 use rotorid::{InitialState, Sampling, Scenario};
 
 /// The six true values in [`Parameter::ALL`] order.
@@ -14,7 +16,7 @@ pub fn truth(sc: &Scenario) -> [f64; 6] {
 }
 
 /// Relative errors of the six estimates.
-pub fn rel_errors(e: &Estimate, truth: &[f64; 6]) -> [f64; 6] {
+pub fn rel_errors(e: &AlgebraicEstimate, truth: &[f64; 6]) -> [f64; 6] {
     let v = e.values();
     std::array::from_fn(|i| (v[i] - truth[i]) / truth[i])
 }
@@ -48,19 +50,23 @@ pub fn response(sc: &Scenario, method: Method) -> TimeResponse {
     simulate(sc, method).expect("simulation")
 }
 
-pub fn estimates(sc: &Scenario, resp: &TimeResponse, quadrature: Quadrature) -> Vec<Estimate> {
-    let config = IdentifierConfig {
+pub fn estimates(
+    sc: &Scenario,
+    resp: &TimeResponse,
+    quadrature: Quadrature,
+) -> Vec<AlgebraicEstimate> {
+    let config = AlgebraicConfig {
         quadrature,
-        ..IdentifierConfig::default()
+        ..AlgebraicConfig::default()
     };
     identify_response(resp, Known::from_rotor(&sc.rotor), config).expect("identification")
 }
 
 /// The estimate at time `t` (sample index round(t / dt)).
-pub fn at(est: &[Estimate], dt: f64, t: f64) -> &Estimate {
+pub fn at(est: &[AlgebraicEstimate], dt: f64, t: f64) -> &AlgebraicEstimate {
     &est[(t / dt).round() as usize]
 }
 
 pub fn names() -> [&'static str; 6] {
-    Parameter::ALL.map(Parameter::name)
+    Parameter::PER_DIRECTION.map(Parameter::name)
 }

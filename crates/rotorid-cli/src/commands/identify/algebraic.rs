@@ -3,7 +3,7 @@
 //!
 //! Per direction, at every sample, solve `A(t) theta = b(t)` for theta = (m, c, k), with
 //! A, b built from running iterated integrals of the measured x(t), z(t) and the known
-//! a, m_u d, alpha (`rotorid::identify::AlgebraicIdentifier`).
+//! a, m_u d, alpha (`rotorid::identify::algebraic::AlgebraicIdentifier`).
 //!
 //! Data flow, all in bounded memory whatever the input length:
 //!
@@ -22,9 +22,10 @@
 use std::io::Read;
 
 use anyhow::Context as _;
-use rotorid::identify::{
-    AlgebraicIdentifier, ConvergenceTracker, Estimate, IdentifierConfig, Measurement, SpeedModel,
+use rotorid::identify::algebraic::{
+    AlgebraicConfig, AlgebraicEstimate, AlgebraicIdentifier, ConvergenceTracker, SpeedModel,
 };
+use rotorid::identify::Measurement;
 
 use super::speed::SpeedSource;
 use super::{base_summary, kept_values, truth_set, Context, IdentifyMethod};
@@ -64,7 +65,7 @@ pub(crate) fn run<R: Read>(
     let write_err = move || format!("cannot write {out_name}");
     let mut writer = EstimatesWriter::new(out).with_context(write_err.clone())?;
     let rcond_min = set.rcond_min_algebraic;
-    let config = IdentifierConfig::new(set.quadrature, rcond_min, SpeedModel::General)?;
+    let config = AlgebraicConfig::new(set.quadrature, rcond_min, SpeedModel::General)?;
     let mut id = AlgebraicIdentifier::new(ctx.view.known(), dt, config)?;
     let mut tracker = ConvergenceTracker::new(set.tol, rcond_min)?;
     let t_first = head[0].t;
@@ -79,7 +80,7 @@ pub(crate) fn run<R: Read>(
             z: row.z,
             speed: speed.at(&row),
         };
-        let mut est: Estimate = id
+        let mut est: AlgebraicEstimate = id
             .push(&m)
             .map_err(|e| CsvError::line(name, row.line, e.to_string()))?;
         est.t = row.t;
@@ -152,7 +153,7 @@ pub(crate) fn too_few_rows(name: &str, rows: u64, needed: u64, why: &str) -> Csv
 }
 
 /// The CSV row of an estimate: m, c, k only where the direction is well conditioned.
-fn row_of(e: &Estimate, ok: [bool; 2]) -> EstimateRow {
+fn row_of(e: &AlgebraicEstimate, ok: [bool; 2]) -> EstimateRow {
     EstimateRow {
         t: e.t,
         values: kept_values(e.x.theta(), e.z.theta(), ok),

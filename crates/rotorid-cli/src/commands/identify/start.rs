@@ -18,8 +18,9 @@
 //! raised to 0 by the fit itself). Quantities not estimated, and a and the unbalance
 //! (whose starting values they are when estimated), come from the scenario.
 
+use rotorid::identify::algebraic::{AlgebraicConfig, AlgebraicIdentifier, SpeedModel};
 use rotorid::identify::modulating::ModulatingEstimate;
-use rotorid::identify::{AlgebraicIdentifier, IdentifierConfig, Measurement, SpeedModel};
+use rotorid::identify::Measurement;
 use rotorid::refine::Unknowns;
 use rotorid::{RotorParams, SpeedProfile, Unbalance};
 
@@ -240,9 +241,8 @@ fn algebraic_start(
     dt: f64,
 ) -> Result<(f64, [Direction; 2]), String> {
     let set = &ctx.settings;
-    let config =
-        IdentifierConfig::new(set.quadrature, set.rcond_min_algebraic, SpeedModel::General)
-            .map_err(|e| e.to_string())?;
+    let config = AlgebraicConfig::new(set.quadrature, set.rcond_min_algebraic, SpeedModel::General)
+        .map_err(|e| e.to_string())?;
     let mut id =
         AlgebraicIdentifier::new(ctx.view.known(), dt, config).map_err(|e| e.to_string())?;
     let mut best: [Option<(f64, [f64; 3])>; 2] = [None, None];

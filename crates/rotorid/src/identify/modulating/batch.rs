@@ -1,12 +1,12 @@
 //! Whole records: a fold of [`ModulatingIdentifier::push`] over the samples, then one
 //! solve, so a batch gives exactly what the streaming identifier gives.
 
-use super::super::batch::record_dt;
-use super::super::inputs::{Known, Measurement};
 use super::config::ModulatingConfig;
 use super::error::ModulatingError;
 use super::estimate::ModulatingEstimate;
 use super::identifier::ModulatingIdentifier;
+use crate::identify::sampling::record_dt;
+use crate::identify::{Known, Measurement};
 use crate::model::SpeedState;
 use crate::simulate::TimeResponse;
 

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::super::error::IdentifyError;
+use crate::identify::InputError;
 use crate::model::check;
 
 /// Default window length L \[s\]: 20 ms, about one period of table1's natural frequency
@@ -19,7 +19,7 @@ pub const MAX_FUNCTIONS: usize = 32;
 /// Default [`ModulatingConfig::rcond_min`]: flags a normal matrix whose condition number
 /// exceeds 1e8 (1e4 for the equilibrated design matrix). On table1 the default window
 /// gives rcond 0.1 - 0.4; a 0.1 s window, too long for the free vibration, 5e-5.
-pub const DEFAULT_RCOND_MIN: f64 = 1e-8;
+pub const DEFAULT_MODULATING_RCOND_MIN: f64 = 1e-8;
 /// Most windows that may overlap one window: hop_s >= window_s / MAX_OVERLAP.
 pub const MAX_OVERLAP: f64 = 64.0;
 
@@ -85,7 +85,7 @@ impl Default for ModulatingConfig {
             hop_s: DEFAULT_WINDOW_S * DEFAULT_HOP_FRACTION,
             functions: DEFAULT_FUNCTIONS,
             noise: NoiseCompensation::Estimated,
-            rcond_min: DEFAULT_RCOND_MIN,
+            rcond_min: DEFAULT_MODULATING_RCOND_MIN,
         }
     }
 }
@@ -105,14 +105,14 @@ impl ModulatingConfig {
     /// frequency `omega_n` \[rad/s\] (finite, > 0; e.g. sqrt(k/m) from a rough guess, a
     /// rap test or the plain algebraic identifier's early estimate): L = 2 pi / omega_n,
     /// hop L / 8.
-    pub fn for_natural_frequency(omega_n: f64) -> Result<Self, IdentifyError> {
+    pub fn for_natural_frequency(omega_n: f64) -> Result<Self, InputError> {
         check("omega_n", omega_n, "finite and > 0 (rad/s)", |v| v > 0.0)?;
         Self::with_window(std::f64::consts::TAU / omega_n).validated()
     }
 
     /// Check every field (ranges in the field docs; the sample counts are checked against
     /// dt when the identifier is built).
-    pub fn validated(self) -> Result<Self, IdentifyError> {
+    pub fn validated(self) -> Result<Self, InputError> {
         check("window_s", self.window_s, "finite and > 0 (s)", |v| v > 0.0)?;
         check(
             "hop_s",

@@ -2,7 +2,7 @@
 //! states what is allowed. A singular least-squares problem is NOT an error (the estimate
 //! is NaN with rcond = 0).
 
-use super::super::error::IdentifyError;
+use crate::identify::InputError;
 use crate::model::OutOfRange;
 
 /// Why the modulating-function identifier could not be built or run.
@@ -11,7 +11,7 @@ pub enum ModulatingError {
     /// A value, measurement or record column the algebraic identifier would also reject
     /// (out of range, not finite, non-uniform sampling, columns of unequal length).
     #[error(transparent)]
-    Input(#[from] IdentifyError),
+    Input(#[from] InputError),
     /// The window is too short in samples for its test functions.
     #[error(
         "window_s = {window_s} s is {intervals} sampling intervals at dt = {dt} s: \
@@ -46,7 +46,7 @@ pub enum ModulatingError {
     },
 }
 
-/// An out-of-range value is the same [`IdentifyError`] the algebraic identifier returns.
+/// An out-of-range value is the same [`InputError`] the algebraic identifier returns.
 impl From<OutOfRange> for ModulatingError {
     fn from(e: OutOfRange) -> Self {
         Self::Input(e.into())

@@ -26,9 +26,6 @@
 
 use std::collections::VecDeque;
 
-use super::super::error::IdentifyError;
-use super::super::identifier::check_on_time;
-use super::super::inputs::{Known, Measurement};
 use super::config::{ModulatingConfig, NoiseCompensation};
 use super::error::ModulatingError;
 use super::estimate::{ModulatingDirection, ModulatingEstimate};
@@ -36,6 +33,9 @@ use super::noise_estimate::DifferenceNoise;
 use super::normal_equations::Gram;
 use super::test_functions::TestFunctions;
 use super::uncertainty::{add_pair, ClosedWindow, Meat, Overlaps};
+use crate::identify::sampling::check_on_time;
+use crate::identify::InputError;
+use crate::identify::{Known, Measurement};
 use crate::model::{check, OutOfRange};
 
 /// Sums per test function in an open window (module docs).
@@ -372,7 +372,7 @@ impl ModulatingIdentifier {
         self.t_prev = f64::NAN;
     }
 
-    fn validate(&self, m: &Measurement) -> Result<(), IdentifyError> {
+    fn validate(&self, m: &Measurement) -> Result<(), InputError> {
         let s = &m.speed;
         let fields = [
             ("t", m.t),
@@ -383,7 +383,7 @@ impl ModulatingIdentifier {
             ("phi_ddot", s.omega_dot),
         ];
         if let Some(&(field, value)) = fields.iter().find(|(_, v)| !v.is_finite()) {
-            return Err(IdentifyError::NotFinite {
+            return Err(InputError::NotFinite {
                 index: self.n,
                 field,
                 value,

@@ -61,7 +61,7 @@ mod uncertainty;
 pub use batch::{identify_modulating, identify_modulating_response};
 pub use config::{
     ModulatingConfig, NoiseCompensation, DEFAULT_FUNCTIONS, DEFAULT_HOP_FRACTION,
-    DEFAULT_RCOND_MIN, DEFAULT_WINDOW_S, MAX_FUNCTIONS, MAX_OVERLAP,
+    DEFAULT_MODULATING_RCOND_MIN, DEFAULT_WINDOW_S, MAX_FUNCTIONS, MAX_OVERLAP,
 };
 pub use error::ModulatingError;
 pub use estimate::{ModulatingDirection, ModulatingEstimate};

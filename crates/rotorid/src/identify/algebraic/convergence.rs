@@ -39,60 +39,17 @@
 
 use serde::Serialize;
 
-use super::config::IdentifierConfig;
-use super::error::IdentifyError;
-use super::estimate::Estimate;
+use super::config::AlgebraicConfig;
+use super::error::AlgebraicError;
+use super::estimate::AlgebraicEstimate;
 use crate::model::check;
+use crate::parameter::Parameter;
 
 /// Default relative tolerance of the convergence band (1 %).
 pub const DEFAULT_TOLERANCE: f64 = 0.01;
 /// Default cap on each staircase (entries); 6 parameters x 2 stacks x 32 bytes x 4096 =
 /// 1.5 MiB at most.
 pub const DEFAULT_STACK_CAPACITY: usize = 4096;
-
-/// One of the six identified parameters.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-pub enum Parameter {
-    /// Mass from the x direction \[kg\].
-    Mx,
-    /// Damping cx \[N s/m\].
-    Cx,
-    /// Stiffness kx \[N/m\].
-    Kx,
-    /// Mass from the z direction \[kg\].
-    Mz,
-    /// Damping cz \[N s/m\].
-    Cz,
-    /// Stiffness kz \[N/m\].
-    Kz,
-}
-
-impl Parameter {
-    /// All six, in the order of [`Estimate::values`].
-    pub const ALL: [Parameter; 6] = [
-        Parameter::Mx,
-        Parameter::Cx,
-        Parameter::Kx,
-        Parameter::Mz,
-        Parameter::Cz,
-        Parameter::Kz,
-    ];
-
-    /// `m_x`, `c_x`, `k_x`, `m_z`, `c_z`, `k_z`.
-    pub fn name(self) -> &'static str {
-        ["m_x", "c_x", "k_x", "m_z", "c_z", "k_z"][self.index()]
-    }
-
-    /// Its unit: `kg`, `N s/m` or `N/m`.
-    pub fn unit(self) -> &'static str {
-        ["kg", "N s/m", "N/m"][self.index() % 3]
-    }
-
-    /// Position in [`Parameter::ALL`] and [`Estimate::values`].
-    pub fn index(self) -> usize {
-        self as usize
-    }
-}
 
 /// The convergence summary of one parameter.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -301,13 +258,17 @@ pub struct ConvergenceTracker {
 impl ConvergenceTracker {
     /// A tracker with relative band `tol` (finite, >= 0) that ignores instants with
     /// rcond < `rcond_min` (in [0, 1]), with the default stack capacity.
-    pub fn new(tol: f64, rcond_min: f64) -> Result<Self, IdentifyError> {
+    pub fn new(tol: f64, rcond_min: f64) -> Result<Self, AlgebraicError> {
         Self::with_capacity(tol, rcond_min, DEFAULT_STACK_CAPACITY)
     }
 
     /// As [`new`](Self::new) with each of the 12 stacks capped at `capacity` entries
     /// (>= 2).
-    pub fn with_capacity(tol: f64, rcond_min: f64, capacity: usize) -> Result<Self, IdentifyError> {
+    pub fn with_capacity(
+        tol: f64,
+        rcond_min: f64,
+        capacity: usize,
+    ) -> Result<Self, AlgebraicError> {
         check("tol", tol, "finite and >= 0 (relative)", |v| v >= 0.0)?;
         check("rcond_min", rcond_min, "finite and in [0, 1]", |v| {
             (0.0..=1.0).contains(&v)
@@ -322,7 +283,7 @@ impl ConvergenceTracker {
     }
 
     /// The default tolerance ([`DEFAULT_TOLERANCE`]) and the identifier's `rcond_min`.
-    pub fn for_config(config: &IdentifierConfig) -> Result<Self, IdentifyError> {
+    pub fn for_config(config: &AlgebraicConfig) -> Result<Self, AlgebraicError> {
         Self::new(DEFAULT_TOLERANCE, config.rcond_min)
     }
 
@@ -343,7 +304,7 @@ impl ConvergenceTracker {
 
     /// Take the next estimate (in time order). Flagged directions are skipped.
     #[inline]
-    pub fn push(&mut self, e: &Estimate) {
+    pub fn push(&mut self, e: &AlgebraicEstimate) {
         self.estimates += 1;
         let ok = e.well_conditioned(self.rcond_min);
         let v = e.values();
@@ -363,13 +324,15 @@ impl ConvergenceTracker {
             .sum()
     }
 
-    /// The summary of one parameter so far.
-    pub fn result(&self, p: Parameter) -> ParameterConvergence {
-        self.tracks[p.index()].result(p, self.tol)
+    /// The summary of one parameter so far; `None` for a parameter the per-direction
+    /// identifier does not estimate (m, a, mud, alpha).
+    pub fn result(&self, p: Parameter) -> Option<ParameterConvergence> {
+        let i = p.direction_index()?;
+        Some(self.tracks[i].result(p, self.tol))
     }
 
-    /// The summaries of all six, in [`Parameter::ALL`] order.
+    /// The summaries of all six, in [`Parameter::PER_DIRECTION`] order.
     pub fn results(&self) -> [ParameterConvergence; 6] {
-        Parameter::ALL.map(|p| self.result(p))
+        std::array::from_fn(|i| self.tracks[i].result(Parameter::PER_DIRECTION[i], self.tol))
     }
 }

@@ -1,11 +1,12 @@
 //! Whole-record identification: a fold of [`AlgebraicIdentifier::push`] over the samples,
 //! so a batch gives bit-for-bit the estimates the streaming identifier gives.
 
-use super::config::IdentifierConfig;
-use super::error::IdentifyError;
-use super::estimate::Estimate;
+use super::config::AlgebraicConfig;
+use super::error::AlgebraicError;
+use super::estimate::AlgebraicEstimate;
 use super::identifier::AlgebraicIdentifier;
-use super::inputs::{Known, Measurement};
+use crate::identify::sampling::record_dt;
+use crate::identify::{Known, Measurement};
 use crate::model::SpeedState;
 use crate::simulate::TimeResponse;
 
@@ -15,8 +16,8 @@ pub fn identify_batch(
     measurements: &[Measurement],
     known: Known,
     dt: f64,
-    config: IdentifierConfig,
-) -> Result<Vec<Estimate>, IdentifyError> {
+    config: AlgebraicConfig,
+) -> Result<Vec<AlgebraicEstimate>, AlgebraicError> {
     let mut id = AlgebraicIdentifier::new(known, dt, config)?;
     let mut out = Vec::with_capacity(measurements.len());
     for m in measurements {
@@ -29,8 +30,8 @@ pub fn identify_batch(
 pub fn identify_response(
     resp: &TimeResponse,
     known: Known,
-    config: IdentifierConfig,
-) -> Result<Vec<Estimate>, IdentifyError> {
+    config: AlgebraicConfig,
+) -> Result<Vec<AlgebraicEstimate>, AlgebraicError> {
     let dt = record_dt(
         &resp.t,
         [
@@ -48,30 +49,6 @@ pub fn identify_response(
         out.push(id.push(&measurement(resp, i))?);
     }
     Ok(out)
-}
-
-/// The sampling period `t[1] - t[0]` \[s\] of a record with times `t` and the other
-/// `columns` (name, length), after checking that every column is as long as `t`
-/// ([`IdentifyError::ColumnLength`] for the first that is not) and that there are at least
-/// two samples ([`IdentifyError::TooFewSamples`]).
-pub(crate) fn record_dt(
-    t: &[f64],
-    columns: [(&'static str, usize); 5],
-) -> Result<f64, IdentifyError> {
-    let n = t.len();
-    for (column, len) in columns {
-        if len != n {
-            return Err(IdentifyError::ColumnLength {
-                column,
-                len,
-                expected: n,
-            });
-        }
-    }
-    if n < 2 {
-        return Err(IdentifyError::TooFewSamples { samples: n });
-    }
-    Ok(t[1] - t[0])
 }
 
 /// Sample `i` of `resp` as a [`Measurement`].

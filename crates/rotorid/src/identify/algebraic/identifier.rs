@@ -52,14 +52,16 @@
 //! costs ~70 ns (~15 million samples/s on one core of an AMD EPYC); on x86_64 the hot path
 //! is compiled for AVX2 when the CPU has it, with bit-for-bit the same results.
 
-use super::config::{IdentifierConfig, SpeedModel};
-use super::error::IdentifyError;
-use super::estimate::{DirectionEstimate, Estimate};
-use super::inputs::{Known, Measurement};
-use super::lanes::F2;
+use super::config::{AlgebraicConfig, SpeedModel};
+use super::error::AlgebraicError;
+use super::estimate::{AlgebraicEstimate, DirectionEstimate};
 use super::quadrature::RunningIntegrals;
-use super::system::{recip_pow2, solve3};
-use super::trig::sin_cos;
+use super::scaled_solve::{recip_pow2, solve3};
+use super::simd::F2;
+use crate::identify::sampling::check_on_time;
+use crate::identify::trig::sin_cos;
+use crate::identify::InputError;
+use crate::identify::{Known, Measurement};
 use crate::model::check;
 
 /// Number of integrated signals: (y, tau y, tau^2 y, u, v) for y = x, z, interleaved
@@ -73,16 +75,13 @@ const T2Y: usize = 4;
 const U: usize = 6;
 const V: usize = 8;
 
-/// Relative jitter allowed on the sampling period (plus 8 ulp of t).
-pub const SAMPLING_TOLERANCE: f64 = 1e-6;
-
 /// The streaming algebraic identifier (module docs). Feed it measurements in time order
 /// with [`push`](Self::push); each returns the estimate at that instant.
 #[derive(Debug, Clone)]
 pub struct AlgebraicIdentifier {
     known: Known,
     dt: f64,
-    config: IdentifierConfig,
+    config: AlgebraicConfig,
     integrals: RunningIntegrals<NS>,
     /// Samples accepted since the start (or the last reset).
     n: u64,
@@ -96,7 +95,7 @@ pub struct AlgebraicIdentifier {
 impl AlgebraicIdentifier {
     /// An identifier for data sampled every `dt` \[s\] (finite, > 0), with the known
     /// quantities `known` (finite) and `config` (validated here).
-    pub fn new(known: Known, dt: f64, config: IdentifierConfig) -> Result<Self, IdentifyError> {
+    pub fn new(known: Known, dt: f64, config: AlgebraicConfig) -> Result<Self, AlgebraicError> {
         let known = known.validated()?;
         let dt = check("dt", dt, "finite and > 0 (s)", |v| v > 0.0)?;
         let config = config.validated()?;
@@ -122,7 +121,7 @@ impl AlgebraicIdentifier {
     }
 
     /// The configuration.
-    pub fn config(&self) -> IdentifierConfig {
+    pub fn config(&self) -> AlgebraicConfig {
         self.config
     }
 
@@ -142,11 +141,11 @@ impl AlgebraicIdentifier {
     /// (tau = 0) and any instant where A is singular give NaN values with rcond = 0.
     ///
     /// Errors (the identifier is left unchanged, so the caller may skip the sample):
-    /// a non-finite field ([`IdentifyError::NotFinite`], naming it; the speed fields are
+    /// a non-finite field ([`InputError::NotFinite`], naming it; the speed fields are
     /// only checked by the general speed model), or a time that is not the previous one
-    /// plus dt within `1e-6 dt + 8 ulp(t)` ([`IdentifyError::NonUniformSampling`]).
+    /// plus dt within `1e-6 dt + 8 ulp(t)` ([`InputError::NonUniformSampling`]).
     #[inline]
-    pub fn push(&mut self, m: &Measurement) -> Result<Estimate, IdentifyError> {
+    pub fn push(&mut self, m: &Measurement) -> Result<AlgebraicEstimate, AlgebraicError> {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is true only when the running CPU supports AVX2.
@@ -158,12 +157,12 @@ impl AlgebraicIdentifier {
     /// [`push`](Self::push) compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn push_avx2(&mut self, m: &Measurement) -> Result<Estimate, IdentifyError> {
+    unsafe fn push_avx2(&mut self, m: &Measurement) -> Result<AlgebraicEstimate, AlgebraicError> {
         self.push_portable(m)
     }
 
     #[inline(always)]
-    fn push_portable(&mut self, m: &Measurement) -> Result<Estimate, IdentifyError> {
+    fn push_portable(&mut self, m: &Measurement) -> Result<AlgebraicEstimate, AlgebraicError> {
         self.validate(m)?;
         let tau = (self.n as i64) as f64 * self.dt; // (i64 -> f64 is one instruction)
         let (sn, cs, w, wd) = speed_at(&self.known, self.config.speed_model, m);
@@ -173,7 +172,7 @@ impl AlgebraicIdentifier {
         self.t_prev = m.t;
         if tau == 0.0 {
             // A = 0 at t_0
-            return Ok(Estimate {
+            return Ok(AlgebraicEstimate {
                 t: m.t,
                 x: DirectionEstimate::SINGULAR,
                 z: DirectionEstimate::SINGULAR,
@@ -186,7 +185,7 @@ impl AlgebraicIdentifier {
             k: theta[2][d],
             rcond: rcond[d],
         };
-        Ok(Estimate {
+        Ok(AlgebraicEstimate {
             t: m.t,
             x: dir(0),
             z: dir(1),
@@ -194,7 +193,7 @@ impl AlgebraicIdentifier {
     }
 
     #[inline(always)]
-    fn validate(&self, m: &Measurement) -> Result<(), IdentifyError> {
+    fn validate(&self, m: &Measurement) -> Result<(), AlgebraicError> {
         let general = self.config.speed_model == SpeedModel::General;
         // v * 0 == 0 exactly when v is finite: one test for all fields.
         let s = &m.speed;
@@ -214,7 +213,7 @@ impl AlgebraicIdentifier {
 
     /// The error naming the first non-finite field of `m`.
     #[cold]
-    fn not_finite(&self, m: &Measurement, general: bool) -> IdentifyError {
+    fn not_finite(&self, m: &Measurement, general: bool) -> AlgebraicError {
         let s = &m.speed;
         let fields = [
             ("t", m.t, true),
@@ -228,30 +227,10 @@ impl AlgebraicIdentifier {
             .into_iter()
             .find(|&(_, v, checked)| checked && !v.is_finite())
             .unwrap_or(("t", m.t, true));
-        IdentifyError::NotFinite {
+        AlgebraicError::Input(InputError::NotFinite {
             index: self.n,
             field,
             value,
-        }
-    }
-}
-
-/// Check that sample `index` at time `t` \[s\] is the previous one at `t_prev` \[s\] plus `dt`
-/// \[s\] within `SAMPLING_TOLERANCE dt + 8 ulp(max(|t|, |t_prev|))`, else
-/// [`IdentifyError::NonUniformSampling`] (a NaN `t` is rejected too).
-#[inline(always)]
-pub(crate) fn check_on_time(index: u64, t: f64, t_prev: f64, dt: f64) -> Result<(), IdentifyError> {
-    let expected = t_prev + dt;
-    let tolerance = SAMPLING_TOLERANCE * dt + 8.0 * f64::EPSILON * t.abs().max(t_prev.abs());
-    if (t - expected).abs() <= tolerance {
-        Ok(())
-    } else {
-        Err(IdentifyError::NonUniformSampling {
-            index,
-            t,
-            expected,
-            tolerance,
-            dt,
         })
     }
 }
@@ -343,7 +322,7 @@ mod tests {
             alpha: 0.7,
         };
         let dt = 1e-4;
-        let mut fast = AlgebraicIdentifier::new(known, dt, IdentifierConfig::default()).unwrap();
+        let mut fast = AlgebraicIdentifier::new(known, dt, AlgebraicConfig::default()).unwrap();
         let mut slow = fast.clone();
         slow.avx2 = false;
         for i in 0..3000 {

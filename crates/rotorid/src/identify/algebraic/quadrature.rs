@@ -40,7 +40,7 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use super::error::IdentifyError;
+use super::error::AlgebraicError;
 use crate::model::check;
 
 /// Number of iterated-integral levels kept by [`RunningIntegrals`] (I1 to I4).
@@ -117,14 +117,14 @@ impl fmt::Display for Quadrature {
 }
 
 impl FromStr for Quadrature {
-    type Err = IdentifyError;
+    type Err = AlgebraicError;
     /// Parse `trapezoid`, `am3`, `am4` or `am5` (case-insensitive).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let lower = s.trim().to_ascii_lowercase();
         Quadrature::ALL
             .into_iter()
             .find(|q| q.name() == lower)
-            .ok_or_else(|| IdentifyError::UnknownQuadrature {
+            .ok_or_else(|| AlgebraicError::UnknownQuadrature {
                 name: s.to_string(),
             })
     }
@@ -345,7 +345,7 @@ enum Engine<const NS: usize> {
 /// [`Quadrature`]. O(NS q) work and no allocation per sample.
 ///
 /// ```
-/// use rotorid::identify::{Quadrature, RunningIntegrals};
+/// use rotorid::identify::algebraic::{Quadrature, RunningIntegrals};
 /// let h = 1e-3;
 /// let mut ri = RunningIntegrals::<1>::new(Quadrature::AdamsMoulton4, h).unwrap();
 /// for n in 0..=1000 {
@@ -363,7 +363,7 @@ pub struct RunningIntegrals<const NS: usize> {
 
 impl<const NS: usize> RunningIntegrals<NS> {
     /// Integrals of signals sampled every `h` \[s\] (finite, > 0) with `quadrature`.
-    pub fn new(quadrature: Quadrature, h: f64) -> Result<Self, IdentifyError> {
+    pub fn new(quadrature: Quadrature, h: f64) -> Result<Self, AlgebraicError> {
         check("dt", h, "finite and > 0 (s)", |v| v > 0.0)?;
         let beta = quadrature.weights();
         let engine = match quadrature {

@@ -4,11 +4,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::error::IdentifyError;
+use super::error::AlgebraicError;
 use super::quadrature::Quadrature;
 use crate::model::check;
 
-/// Default [`IdentifierConfig::rcond_min`]: instants whose scaled 3x3 system has a
+/// Default [`AlgebraicConfig::rcond_min`]: instants whose scaled 3x3 system has a
 /// reciprocal condition number below this are flagged (ill-conditioned).
 ///
 /// Calibrated on table1 (1200 rpm and the 10 rad/s^2 ramps from rest and from 1200 rpm,
@@ -20,7 +20,7 @@ use crate::model::check;
 /// Errors in the data (noise, a discretised simulation) raise the error of a
 /// well-conditioned instant to ~(data error)/rcond: raise the threshold for such data.
 /// See `tests/identify_conditioning.rs`.
-pub const DEFAULT_RCOND_MIN: f64 = 1e-5;
+pub const DEFAULT_ALGEBRAIC_RCOND_MIN: f64 = 1e-5;
 
 /// How the rotor angle and speed are obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
@@ -41,33 +41,33 @@ pub enum SpeedModel {
 
 /// Settings of [`super::AlgebraicIdentifier`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct IdentifierConfig {
+pub struct AlgebraicConfig {
     /// The running quadrature for every iterated integral (default: order 5).
     pub quadrature: Quadrature,
     /// Instants with rcond < `rcond_min` are flagged as ill-conditioned (dimensionless,
-    /// in [0, 1]; default [`DEFAULT_RCOND_MIN`]).
+    /// in [0, 1]; default [`DEFAULT_ALGEBRAIC_RCOND_MIN`]).
     pub rcond_min: f64,
     /// Where phi, w, w' come from (default: from the measurements).
     pub speed_model: SpeedModel,
 }
 
-impl Default for IdentifierConfig {
+impl Default for AlgebraicConfig {
     fn default() -> Self {
         Self {
             quadrature: Quadrature::default(),
-            rcond_min: DEFAULT_RCOND_MIN,
+            rcond_min: DEFAULT_ALGEBRAIC_RCOND_MIN,
             speed_model: SpeedModel::General,
         }
     }
 }
 
-impl IdentifierConfig {
+impl AlgebraicConfig {
     /// A validated configuration (see [`validated`](Self::validated)).
     pub fn new(
         quadrature: Quadrature,
         rcond_min: f64,
         speed_model: SpeedModel,
-    ) -> Result<Self, IdentifyError> {
+    ) -> Result<Self, AlgebraicError> {
         Self {
             quadrature,
             rcond_min,
@@ -78,7 +78,7 @@ impl IdentifierConfig {
 
     /// The default configuration for a rotor at constant speed `omega` \[rad/s\] from angle
     /// `phi0` \[rad\] at t = 0.
-    pub fn constant_speed(omega: f64, phi0: f64) -> Result<Self, IdentifyError> {
+    pub fn constant_speed(omega: f64, phi0: f64) -> Result<Self, AlgebraicError> {
         Self {
             speed_model: SpeedModel::Constant { omega, phi0 },
             ..Self::default()
@@ -87,7 +87,7 @@ impl IdentifierConfig {
     }
 
     /// Check: rcond_min in [0, 1]; a constant speed's omega and phi0 finite.
-    pub fn validated(self) -> Result<Self, IdentifyError> {
+    pub fn validated(self) -> Result<Self, AlgebraicError> {
         check("rcond_min", self.rcond_min, "finite and in [0, 1]", |v| {
             (0.0..=1.0).contains(&v)
         })?;

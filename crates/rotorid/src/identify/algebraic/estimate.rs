@@ -41,7 +41,7 @@ impl DirectionEstimate {
 
 /// Both directions' estimates at time t.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Estimate {
+pub struct AlgebraicEstimate {
     /// Time of the measurement the estimate is for \[s\].
     pub t: f64,
     /// Horizontal direction: m, cx, kx.
@@ -50,7 +50,7 @@ pub struct Estimate {
     pub z: DirectionEstimate,
 }
 
-impl Estimate {
+impl AlgebraicEstimate {
     /// [x well conditioned, z well conditioned] at threshold `rcond_min`
     /// (see [`DirectionEstimate::well_conditioned`]).
     pub fn well_conditioned(&self, rcond_min: f64) -> [bool; 2] {

@@ -28,7 +28,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::lanes::F2;
+use super::simd::F2;
 
 /// The solution of one scaled 3x3 system.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,0 +1,26 @@
+//! Errors of the algebraic identifier: those of its inputs ([`InputError`]) and an unknown
+//! quadrature name. A singular or ill-conditioned system is NOT an error (the estimate is
+//! NaN / flagged).
+
+use crate::identify::InputError;
+use crate::model::OutOfRange;
+
+/// Why the algebraic identifier could not be built or could not take a measurement.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AlgebraicError {
+    /// A configuration value, known quantity or sample the identifier cannot take.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// A quadrature name that is not known.
+    #[error("unknown quadrature {name:?}: expected \"trapezoid\", \"am3\", \"am4\" or \"am5\"")]
+    UnknownQuadrature {
+        /// The name as given.
+        name: String,
+    },
+}
+
+impl From<OutOfRange> for AlgebraicError {
+    fn from(e: OutOfRange) -> Self {
+        Self::Input(e.into())
+    }
+}
