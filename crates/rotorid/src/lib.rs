@@ -7,12 +7,15 @@
 //! - [`simulate`]: Newmark (as in the paper) and an exact/high-accuracy reference, noise.
 //! - [`identify`]: running integrals and the algebraic identifiers, streaming and batch.
 //! - [`refine`]: output-error (maximum-likelihood) refinement with uncertainties.
+//! - [`pipeline`]: record -> identification with diagnostics, the entry point of every
+//!   caller (batch [`pipeline::identify`] and streaming [`pipeline::Session`]).
 //!
 //! Pure computation: no file I/O, no plotting (those live in the `rotorid` command).
 
 pub mod identify;
 pub mod model;
 pub mod parameter;
+pub mod pipeline;
 pub mod refine;
 pub mod simulate;
 

@@ -1,39 +1,18 @@
-//! `rotorid identify`: identify m, c, k (and optionally a and the unbalance) of the rotor of
-//! the paper's eq. (1) from a response CSV, by one of three methods (`--method`):
-//!
-//! - `algebraic` (default): the paper's algebraic identifier (eqs. 7-8; method.md section
-//!   5), streaming, one estimate per sample: per direction solve `A(t) theta = b(t)`,
-//!   theta = (m, c, k), A, b built from running iterated integrals of x(t), z(t) and the
-//!   known a, m_u d, alpha (module `algebraic`).
-//! - `modulating`: least squares over windows of the modulating-function equations
-//!   `m int psi'' y - c int psi' y + k int psi y = (known coupling and forcing)`
-//!   (`rotorid::identify::modulating`; method.md section 6, a robust variant), one
-//!   estimate at the end of the record (module `modulating`).
-//! - `refine`: maximum likelihood (output error) on the whole record,
-//!   `min_theta  N/2 ln S_x(theta) + N/2 ln S_z(theta)`, `S = sum_k (y_k - y(t_k; theta))^2`,
-//!   with standard errors from the Fisher information and the Cramer-Rao bound
-//!   (`rotorid::refine`; method.md section 7), started from the modulating estimate
-//!   (module `refine`, start in `start`).
-//!
-//! Every method reads the input through the same validating reader (`io::response_csv`:
-//! errors name file, line and column), writes the estimates CSV (`io::estimates_csv`) and
-//! the summary (`io::summary`). The speed comes from the CSV's phi, phi_dot, phi_ddot
-//! columns when present, else from the scenario's `[speed]` profile (`speed`).
+//! `rotorid identify`: read a response CSV, identify it through the library's pipeline
+//! (`rotorid::pipeline`: the method, its start, the masking of what the record does not
+//! determine and every diagnostic are decided there), and write the estimates CSV, the
+//! summary (the serialised `Identification`) and a report on stderr.
 
-mod algebraic;
-mod modulating;
-mod record;
-mod refine;
-mod speed;
-mod start;
+mod report;
+mod stream;
 
 use anyhow::Context as _;
 use rotorid::identify::algebraic::Quadrature;
+use rotorid::identify::modulating::ModulatingConfig;
+use rotorid::pipeline::{AlgebraicSettings, Method, ModulatingSettings, RefineSettings};
+use rotorid::refine::Unknowns;
 
-use crate::io::{
-    is_broken_pipe, open_input, EstimateRow, EstimatesWriter, FileMode, FlushBeforeRead, Output,
-    ParameterSet, ScenarioSpec, SharedWriter, Summary, Truth, SUMMARY_FORMAT_VERSION,
-};
+use crate::io::{is_broken_pipe, open_input, FileMode, Output, ScenarioSpec};
 
 // The defaults shown in `--help`, each written once (a test keeps them equal to the
 // library's constants): the algebraic identifier's calibrated
@@ -263,87 +242,48 @@ pub enum UnknownName {
     Unbalance,
 }
 
-/// The settings every method shares, with the per-method defaults applied.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Settings {
-    pub quadrature: Quadrature,
-    pub every: u64,
-    pub tol: f64,
-    /// Threshold of the algebraic identifier.
-    pub rcond_min_algebraic: f64,
-    /// Threshold of the modulating identifier.
-    pub rcond_min_modulating: f64,
-    pub window_s: f64,
-}
-
-/// Run `rotorid identify`.
+/// Run `rotorid identify`: scenario and options -> pipeline -> outputs.
 pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
-    let settings = check_args(&args)?;
+    let method = method_of(&args)?;
     let spec = ScenarioSpec::load(&args.scenario)?;
-    let view = spec.identification()?;
     let (name, input) = open_input(&args.input)?;
+    let live = args.input == "-" || !std::fs::metadata(&args.input).is_ok_and(|m| m.is_file());
     let out = Output::create(&args.out, FileMode::Direct)?;
     let to_stdout = out.is_stdout();
-    let shared = SharedWriter::new(out);
-    let input = FlushBeforeRead::new(input, shared.clone());
-    let ctx = Context {
-        args: &args,
-        settings,
-        spec: &spec,
-        view,
+    let io = stream::Io {
         name: &name,
+        out_name: &args.out,
+        live,
+        every: args.every.unwrap_or(1),
     };
-    let result = match args.method {
-        IdentifyMethod::Algebraic => algebraic::run(&ctx, input, shared.clone()),
-        IdentifyMethod::Modulating => modulating::run(&ctx, input, shared.clone()),
-        IdentifyMethod::Refine => refine::run(&ctx, input, shared.clone()),
-    };
-    let summary = match result {
-        Ok(s) => s,
+    let mut ident = match stream::identify(&io, input, out, &spec, &method, args.time_tolerance) {
+        Ok(i) => i,
         Err(e) if to_stdout && is_broken_pipe(&e) => return Ok(()),
-        Err(e) => {
-            // Keep the whole rows written so far (Direct mode), then report.
-            let _ = std::io::Write::flush(&mut shared.clone());
-            return Err(e);
-        }
+        Err(e) => return Err(e),
     };
-    let out = shared
-        .try_unwrap()
-        .ok()
-        .expect("every other handle is dropped with the reader");
-    match out.commit() {
-        Err(e) if to_stdout && is_broken_pipe(&e) => return Ok(()),
-        r => r?,
-    }
+    ident.input = Some(args.input.clone());
+    ident.scenario = Some(spec.origin().to_owned());
     if let Some(path) = &args.summary {
         let mut f = Output::create(path, FileMode::Atomic)?;
-        serde_json::to_writer_pretty(&mut f, &summary)
+        serde_json::to_writer_pretty(&mut f, &ident)
             .with_context(|| format!("cannot write {path}"))?;
         std::io::Write::write_all(&mut f, b"\n").with_context(|| format!("cannot write {path}"))?;
         f.commit()?;
     }
-    if args.quiet {
-        for w in crate::io::summary::warning_lines(&summary) {
-            eprintln!("{w}");
-        }
+    let text = if args.quiet {
+        report::warning_lines(&ident).join("\n")
     } else {
-        eprintln!("{}", crate::io::summary::human_report(&summary));
+        report::human(&ident)
+    };
+    if !text.is_empty() {
+        eprintln!("{text}");
     }
     Ok(())
 }
 
-/// What every method needs besides its input and output.
-pub(crate) struct Context<'a> {
-    pub args: &'a IdentifyArgs,
-    pub settings: Settings,
-    pub spec: &'a ScenarioSpec,
-    pub view: crate::io::IdentificationScenario,
-    /// The input's name in messages (`<stdin>` for `-`).
-    pub name: &'a str,
-}
-
-fn check_args(args: &IdentifyArgs) -> anyhow::Result<Settings> {
-    use rotorid::identify::modulating::{DEFAULT_MODULATING_RCOND_MIN, DEFAULT_WINDOW_S};
+/// The method and its settings from the options (each option checked against its method
+/// and its range).
+fn method_of(args: &IdentifyArgs) -> anyhow::Result<Method> {
     let ok = |v: f64| v.is_finite() && v >= 0.0;
     let method = args.method;
     let only = |flag: &str, given: bool, allowed: &[IdentifyMethod]| -> anyhow::Result<()> {
@@ -367,20 +307,31 @@ fn check_args(args: &IdentifyArgs) -> anyhow::Result<Settings> {
     )?;
     only("--window", args.window.is_some(), &[Modulating, Refine])?;
     only("--unknowns", args.unknowns.is_some(), &[Refine])?;
-    let tol = args
-        .tol
-        .unwrap_or(rotorid::identify::algebraic::DEFAULT_TOLERANCE);
-    if !ok(tol) {
-        anyhow::bail!("--tol = {tol} is out of range: must be finite and >= 0 (relative)");
+    let mut algebraic = AlgebraicSettings {
+        quadrature: args.quadrature.unwrap_or_default(),
+        ..AlgebraicSettings::default()
+    };
+    if let Some(tol) = args.tol {
+        if !ok(tol) {
+            anyhow::bail!("--tol = {tol} is out of range: must be finite and >= 0 (relative)");
+        }
+        algebraic.tol = tol;
     }
+    let window_s = args
+        .window
+        .unwrap_or(rotorid::identify::modulating::DEFAULT_WINDOW_S);
+    if !(window_s.is_finite() && window_s > 0.0) {
+        anyhow::bail!("--window = {window_s} is out of range: must be finite and > 0 (s)");
+    }
+    let mut modulating = ModulatingSettings {
+        config: ModulatingConfig::with_window(window_s),
+    };
     if let Some(r) = args.rcond_min {
         if !(ok(r) && r <= 1.0) {
             anyhow::bail!("--rcond-min = {r} is out of range: must be in [0, 1]");
         }
-    }
-    let window_s = args.window.unwrap_or(DEFAULT_WINDOW_S);
-    if !(window_s.is_finite() && window_s > 0.0) {
-        anyhow::bail!("--window = {window_s} is out of range: must be finite and > 0 (s)");
+        algebraic.rcond_min = r;
+        modulating.config.rcond_min = r;
     }
     if !ok(args.time_tolerance) {
         anyhow::bail!(
@@ -388,87 +339,41 @@ fn check_args(args: &IdentifyArgs) -> anyhow::Result<Settings> {
             args.time_tolerance
         );
     }
-    Ok(Settings {
-        quadrature: args.quadrature.unwrap_or_default(),
-        every: args.every.unwrap_or(1),
-        tol,
-        rcond_min_algebraic: args
-            .rcond_min
-            .unwrap_or(rotorid::identify::algebraic::DEFAULT_ALGEBRAIC_RCOND_MIN),
-        rcond_min_modulating: args.rcond_min.unwrap_or(DEFAULT_MODULATING_RCOND_MIN),
-        window_s,
+    Ok(match method {
+        Algebraic => Method::Algebraic(algebraic),
+        Modulating => Method::Modulating(modulating),
+        Refine => Method::Refine(RefineSettings {
+            unknowns: unknowns_of(args.unknowns.as_deref()),
+            algebraic,
+            modulating,
+            ..RefineSettings::default()
+        }),
     })
 }
 
-/// The truth as a parameter set (m for both m_x and m_z), `None` without any truth.
-pub fn truth_set(t: &Truth) -> Option<ParameterSet<Option<f64>>> {
-    (!t.is_empty()).then_some(ParameterSet {
-        m_x: t.m,
-        c_x: t.cx,
-        k_x: t.kx,
-        m_z: t.m,
-        c_z: t.cz,
-        k_z: t.kz,
-    })
-}
-
-/// The summary's fields common to every method, with the method-specific ones null (the
-/// algebraic method's whole summary; the batch methods fill in the rest).
-pub(crate) fn base_summary(ctx: &Context, method: IdentifyMethod) -> Summary {
-    Summary {
-        format_version: SUMMARY_FORMAT_VERSION,
-        ..Summary::new(
-            ctx.args.input.clone(),
-            ctx.spec.origin().to_owned(),
-            method.name().to_owned(),
-            ctx.settings.rcond_min_for(method),
-        )
-    }
-}
-
-/// The CSV values of an estimate: (m, c, k) of x and of z, each kept only where its
-/// direction is well conditioned (`ok` = [x, z]) and the value is finite.
-pub(crate) fn kept_values(x: [f64; 3], z: [f64; 3], ok: [bool; 2]) -> ParameterSet<Option<f64>> {
-    let keep = |v: f64, ok: bool| (ok && v.is_finite()).then_some(v);
-    ParameterSet {
-        m_x: keep(x[0], ok[0]),
-        c_x: keep(x[1], ok[0]),
-        k_x: keep(x[2], ok[0]),
-        m_z: keep(z[0], ok[1]),
-        c_z: keep(z[1], ok[1]),
-        k_z: keep(z[2], ok[1]),
-    }
-}
-
-/// Write the estimates CSV of a batch method: the header and its one `row`, to `out`
-/// (named `out_name` in the error).
-pub(crate) fn write_single_row(
-    out: SharedWriter<Output>,
-    out_name: &str,
-    row: &EstimateRow,
-) -> anyhow::Result<()> {
-    let mut writer =
-        EstimatesWriter::new(out).with_context(|| format!("cannot write {out_name}"))?;
-    writer
-        .write(row)
-        .with_context(|| format!("cannot write {out_name}"))
-}
-
-impl Settings {
-    /// The conditioning threshold that applies to `method` (refine: that of its start,
-    /// the modulating identifier's unless it falls back).
-    pub fn rcond_min_for(&self, method: IdentifyMethod) -> f64 {
-        match method {
-            IdentifyMethod::Algebraic => self.rcond_min_algebraic,
-            IdentifyMethod::Modulating | IdentifyMethod::Refine => self.rcond_min_modulating,
-        }
+/// The unknowns `--unknowns` selects (default m, cx, kx, cz, kz); the initial state is
+/// always estimated.
+fn unknowns_of(names: Option<&[UnknownName]>) -> Unknowns {
+    let Some(names) = names else {
+        return Unknowns::default();
+    };
+    let has = |n: UnknownName| names.contains(&n);
+    Unknowns {
+        m: has(UnknownName::M),
+        cx: has(UnknownName::Cx),
+        kx: has(UnknownName::Kx),
+        cz: has(UnknownName::Cz),
+        kz: has(UnknownName::Kz),
+        a: has(UnknownName::A),
+        unbalance: has(UnknownName::Unbalance),
+        initial_state: true,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::DEFAULT_TIME_TOLERANCE;
+    use rotorid::pipeline::DEFAULT_TIME_TOLERANCE;
 
     #[test]
     fn help_defaults_are_the_library_defaults() {

@@ -24,8 +24,7 @@ use anyhow::{bail, Context};
 
 use crate::io::columns::{csv_reader, normalise, read_error};
 use crate::io::{
-    open_input, EstimateRow, EstimatesReader, ResponseReader, ScenarioSpec, Truth,
-    DEFAULT_TIME_TOLERANCE, ESTIMATES_HEADER,
+    open_input, EstimateRow, EstimatesReader, ResponseReader, ScenarioSpec, Truth, ESTIMATES_HEADER,
 };
 use crate::plot::scale::si_prefix;
 use crate::plot::{palette, save, Figure, ImageFormat, Panel, Series};
@@ -136,7 +135,7 @@ pub fn detect(name: &str, bytes: &[u8]) -> anyhow::Result<CsvKind> {
 }
 
 fn read_response(name: &str, bytes: &[u8]) -> anyhow::Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
-    let mut r = ResponseReader::new(name, bytes, DEFAULT_TIME_TOLERANCE)?;
+    let mut r = ResponseReader::new(name, bytes)?;
     let (mut t, mut x, mut z) = (Vec::new(), Vec::new(), Vec::new());
     while let Some(row) = r.next_row()? {
         t.push(row.t);

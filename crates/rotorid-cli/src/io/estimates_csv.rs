@@ -82,8 +82,12 @@ impl<W: Write> EstimatesWriter<W> {
         )
     }
 
+    /// Flush the underlying writer.
+    pub fn flush(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+
     /// The underlying writer (not flushed).
-    #[cfg(test)]
     pub fn into_inner(self) -> W {
         self.out
     }

@@ -5,7 +5,7 @@
 //! | scenario TOML (rotor, speed, sampling, initial state; SI) | [`scenario`] | you | simulate, identify |
 //! | response CSV `t,x,z,phi,phi_dot,phi_ddot` (s, m, m, rad, rad/s, rad/s^2) | [`response_csv`] | simulate | identify, plot |
 //! | estimates CSV `t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z` | [`estimates_csv`] | identify | plot |
-//! | summary JSON | [`summary`] | identify | scripts, plot |
+//! | summary JSON: the serialised `rotorid::pipeline::Identification` (docs/summary.md) | - | identify | scripts, analyze |
 //!
 //! Numbers are written in shortest round-trip form ([`number`]): reading a value back gives
 //! the identical `f64`. Readers report errors as `FILE line L, column C (NAME): ...`
@@ -21,12 +21,10 @@ pub mod params;
 pub mod progress;
 pub mod response_csv;
 pub mod scenario;
-pub mod summary;
 
 pub use csv_error::CsvError;
 pub use estimates_csv::{EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES_HEADER};
-pub use output::{is_broken_pipe, open_input, FileMode, FlushBeforeRead, Output, SharedWriter};
+pub use output::{is_broken_pipe, open_input, FileMode, Output};
 pub use params::ParameterSet;
-pub use response_csv::{ResponseReader, ResponseRow, ResponseWriter, DEFAULT_TIME_TOLERANCE};
-pub use scenario::{IdentificationScenario, ScenarioSpec, SimulationOverrides, Truth};
-pub use summary::{Directions, Summary, SUMMARY_FORMAT_VERSION};
+pub use response_csv::{ResponseReader, ResponseWriter};
+pub use scenario::{ScenarioSpec, SimulationOverrides, Truth};

@@ -13,16 +13,10 @@
 //!   with one `write_all` through a `BufWriter`, so the file only ever holds whole rows;
 //!   after an error it holds the rows produced before it.
 //!
-//! [`FlushBeforeRead`] wraps an input so that the output is flushed whenever the input runs
-//! dry (just before each underlying `read`): in a pipe from a live acquisition the output is
-//! always current when we would block waiting for data, at the cost of one flush per input
-//! buffer refill rather than one per row.
 
-use std::cell::RefCell;
 use std::fs::{File, OpenOptions};
 use std::io::{self, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
-use std::rc::Rc;
 
 use anyhow::Context as _;
 
@@ -187,64 +181,6 @@ pub fn open_input(arg: &str) -> anyhow::Result<(String, Box<dyn Read>)> {
     }
 }
 
-/// A cloneable handle to one writer, so that a row writer and a [`FlushBeforeRead`] input
-/// can share the same output (single-threaded).
-pub struct SharedWriter<W>(Rc<RefCell<W>>);
-
-impl<W> Clone for SharedWriter<W> {
-    fn clone(&self) -> Self {
-        Self(Rc::clone(&self.0))
-    }
-}
-
-impl<W> SharedWriter<W> {
-    /// Share `w`.
-    pub fn new(w: W) -> Self {
-        Self(Rc::new(RefCell::new(w)))
-    }
-
-    /// The writer back, once every other handle has been dropped.
-    pub fn try_unwrap(self) -> Result<W, Self> {
-        Rc::try_unwrap(self.0)
-            .map(RefCell::into_inner)
-            .map_err(Self)
-    }
-}
-
-impl<W: Write> Write for SharedWriter<W> {
-    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.0.borrow_mut().write(buf)
-    }
-    fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
-        self.0.borrow_mut().write_all(buf)
-    }
-    fn flush(&mut self) -> io::Result<()> {
-        self.0.borrow_mut().flush()
-    }
-}
-
-/// A reader that flushes a writer just before each read of the underlying input, i.e.
-/// whenever the consumer's input buffer has run dry (see the module doc).
-pub struct FlushBeforeRead<R, W: Write> {
-    inner: R,
-    out: W,
-}
-
-impl<R, W: Write> FlushBeforeRead<R, W> {
-    /// Wrap `inner`; `out` (typically a [`SharedWriter`] clone) is flushed before every
-    /// `inner.read`.
-    pub fn new(inner: R, out: W) -> Self {
-        Self { inner, out }
-    }
-}
-
-impl<R: Read, W: Write> Read for FlushBeforeRead<R, W> {
-    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        self.out.flush()?;
-        self.inner.read(buf)
-    }
-}
-
 /// True when `e` (or what it wraps) is a broken pipe: the reader of our stdout went away
 /// (`rotorid ... | head`), which ends the run quietly rather than as an error. A broken
 /// pipe met while flushing before a read arrives wrapped in a [`super::CsvError`].
@@ -301,29 +237,5 @@ mod tests {
         }
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "a,b\n1,2\n");
         std::fs::remove_dir_all(&d).unwrap();
-    }
-
-    #[test]
-    fn flush_happens_before_each_read() {
-        struct Counting(Vec<usize>, usize);
-        impl Write for Counting {
-            fn write(&mut self, b: &[u8]) -> io::Result<usize> {
-                self.1 += b.len();
-                Ok(b.len())
-            }
-            fn flush(&mut self) -> io::Result<()> {
-                self.0.push(self.1);
-                Ok(())
-            }
-        }
-        let mut out = SharedWriter::new(Counting(Vec::new(), 0));
-        let mut r = FlushBeforeRead::new(&b"0123456789"[..], out.clone());
-        let mut buf = [0u8; 4];
-        out.write_all(b"xy").unwrap();
-        assert_eq!(r.read(&mut buf).unwrap(), 4);
-        out.write_all(b"z").unwrap();
-        assert_eq!(r.read(&mut buf).unwrap(), 4);
-        drop(r);
-        assert_eq!(out.try_unwrap().ok().unwrap().0, vec![2, 3]);
     }
 }

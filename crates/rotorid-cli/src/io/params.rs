@@ -21,14 +21,8 @@ pub struct ParameterSet<T> {
     pub k_z: T,
 }
 
-/// The parameter names, in the order of [`ParameterSet::to_array`] and of the estimates CSV.
-pub const PARAMETER_NAMES: [&str; 6] = ["m_x", "c_x", "k_x", "m_z", "c_z", "k_z"];
-
-/// The unit of each parameter, in the same order.
-pub const PARAMETER_UNITS: [&str; 6] = ["kg", "N s/m", "N/m", "kg", "N s/m", "N/m"];
-
 impl<T> ParameterSet<T> {
-    /// From values in [`PARAMETER_NAMES`] order.
+    /// From values in the order of the estimates CSV (m_x, c_x, k_x, m_z, c_z, k_z).
     pub fn from_array([m_x, c_x, k_x, m_z, c_z, k_z]: [T; 6]) -> Self {
         Self {
             m_x,
@@ -42,7 +36,7 @@ impl<T> ParameterSet<T> {
 }
 
 impl<T: Copy> ParameterSet<T> {
-    /// The values in [`PARAMETER_NAMES`] order.
+    /// The values in the order of the estimates CSV (m_x, c_x, k_x, m_z, c_z, k_z).
     pub fn to_array(self) -> [T; 6] {
         [self.m_x, self.c_x, self.k_x, self.m_z, self.c_z, self.k_z]
     }

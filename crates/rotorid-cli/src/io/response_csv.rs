@@ -14,12 +14,10 @@
 //!   header names may carry a unit suffix (`x [m]`; see [`super::columns`]);
 //! - `t`, `x`, `z` required; `phi`, `phi_dot`, `phi_ddot` all three or none (partial is an
 //!   error naming the missing ones);
-//! - every used field a finite number; rows as long as the header;
-//! - time strictly increasing and uniformly sampled: with `dt = t_2 - t_1` (the first two
-//!   data rows), every later step must satisfy `|(t_i - t_(i-1)) - dt| <= tol * dt`,
-//!   `tol` = [`DEFAULT_TIME_TOLERANCE`] (1e-6) unless relaxed. A file written by
-//!   `simulate` (t_i = i dt exactly) passes with margin: its steps differ from dt by a few
-//!   ulps of t, e.g. 3e-14 s at t = 200 s, 3e-10 of dt = 0.1 ms.
+//! - every used field a finite number; rows as long as the header.
+//!
+//! The time grid (increasing, uniform within a tolerance, dt fitted over the stamps) is
+//! checked by the library (`rotorid::pipeline::TimeGrid`), not here.
 //!
 //! Errors name the file, the line (header = line 1) and the column (see
 //! [`super::csv_error`]).
@@ -35,9 +33,6 @@ use super::number::write_row;
 
 /// The header `simulate` writes.
 pub const RESPONSE_HEADER: [&str; 6] = ["t", "x", "z", "phi", "phi_dot", "phi_ddot"];
-
-/// Default relative tolerance on the sampling period (see the module doc).
-pub const DEFAULT_TIME_TOLERANCE: f64 = 1e-6;
 
 /// Writes the response CSV, one sample per row (see the module doc).
 pub struct ResponseWriter<W: Write> {
@@ -101,25 +96,12 @@ pub struct ResponseReader<R: Read> {
     txz: [usize; 3],
     phi: Option<[usize; 3]>,
     rec: ByteRecord,
-    tol: f64,
     rows: u64,
-    first: Option<(f64, u64)>,
-    prev: Option<(f64, u64)>,
-    dt: Option<f64>,
 }
 
 impl<R: Read> ResponseReader<R> {
-    /// Read and check the header of `input`; `file` names it in messages; `time_tolerance`
-    /// is the relative tolerance on the sampling period (finite and >= 0).
-    pub fn new(file: &str, input: R, time_tolerance: f64) -> Result<Self, CsvError> {
-        if !(time_tolerance.is_finite() && time_tolerance >= 0.0) {
-            return Err(CsvError::file(
-                file,
-                format!(
-                    "time tolerance = {time_tolerance} is out of range: must be finite and >= 0"
-                ),
-            ));
-        }
+    /// Read and check the header of `input`; `file` names it in messages.
+    pub fn new(file: &str, input: R) -> Result<Self, CsvError> {
         let mut csv = csv_reader(input);
         let mut rec = ByteRecord::new();
         let found = csv
@@ -168,27 +150,13 @@ impl<R: Read> ResponseReader<R> {
             txz: [txz[0], txz[1], txz[2]],
             phi,
             rec,
-            tol: time_tolerance,
             rows: 0,
-            first: None,
-            prev: None,
-            dt: None,
         })
     }
 
     /// True when the file has the phi, phi_dot, phi_ddot columns.
     pub fn has_phi(&self) -> bool {
         self.phi.is_some()
-    }
-
-    /// Data rows read so far.
-    pub fn rows(&self) -> u64 {
-        self.rows
-    }
-
-    /// The sampling period dt = t_2 - t_1 [s], once two rows have been read.
-    pub fn dt(&self) -> Option<f64> {
-        self.dt
     }
 
     /// The next validated row, or `None` at the end of the input.
@@ -216,7 +184,6 @@ impl<R: Read> ResponseReader<R> {
             }),
             None => None,
         };
-        self.check_time(t, line)?;
         self.rows += 1;
         Ok(Some(ResponseRow {
             line,
@@ -226,51 +193,6 @@ impl<R: Read> ResponseReader<R> {
             speed,
         }))
     }
-
-    fn check_time(&mut self, t: f64, line: u64) -> Result<(), CsvError> {
-        let f = self.file.as_str();
-        let col = self.txz[0];
-        if let Some((tp, lp)) = self.prev {
-            let step = t - tp;
-            if step <= 0.0 {
-                return Err(CsvError::field(
-                    f,
-                    line,
-                    col,
-                    "t",
-                    format!(
-                        "time is not strictly increasing: t = {t} s follows t = {tp} s (line {lp})"
-                    ),
-                ));
-            }
-            match self.dt {
-                None => self.dt = Some(step),
-                Some(dt) => {
-                    if (step - dt).abs() > self.tol * dt {
-                        let (t1, l1) = self.first.expect("set with prev");
-                        return Err(CsvError::field(
-                            f,
-                            line,
-                            col,
-                            "t",
-                            format!(
-                                "sampling is not uniform: t = {t} s is {step:.9e} s after the \
-                                 previous sample (line {lp}), but dt = {dt:.9e} s (from t = \
-                                 {t1} s at line {l1} to the next row); the allowed deviation is \
-                                 {:e} of dt = {:.3e} s (relax it with --time-tolerance)",
-                                self.tol,
-                                self.tol * dt
-                            ),
-                        ));
-                    }
-                }
-            }
-        } else {
-            self.first = Some((t, line));
-        }
-        self.prev = Some((t, line));
-        Ok(())
-    }
 }
 
 #[cfg(test)]
@@ -278,7 +200,7 @@ mod tests {
     use super::*;
 
     fn read_all(text: &str) -> Result<Vec<ResponseRow>, CsvError> {
-        let mut r = ResponseReader::new("d.csv", text.as_bytes(), DEFAULT_TIME_TOLERANCE)?;
+        let mut r = ResponseReader::new("d.csv", text.as_bytes())?;
         let mut rows = Vec::new();
         while let Some(row) = r.next_row()? {
             rows.push(row);
@@ -358,27 +280,5 @@ mod tests {
             "d.csv line 4: short row: 2 fields where the header (line 1) has 3"
         );
         assert!(err(&format!("{h}0.2,0,0,9\n")).starts_with("d.csv line 4: long row"));
-        assert!(err(&format!("{h}0.1,0,0\n")).starts_with(
-            "d.csv line 4, column 1 (t): time is not strictly increasing: t = 0.1 s follows \
-             t = 0.1 s (line 3)"
-        ));
-        assert!(err(&format!("{h}0.3,0,0\n")).starts_with(
-            "d.csv line 4, column 1 (t): sampling is not uniform: t = 0.3 s is 2.000000000e-1 s after the previous sample \
-             (line 3), but dt = 1.000000000e-1 s (from t = 0 s at line 2 to the next row); the \
-             allowed deviation is 1e-6 of dt = 1.000e-7 s"
-        ));
-        assert!(err("t,x,z\n0,0,0\n-1,0,0\n").contains("line 3, column 1 (t): time is not"));
-    }
-
-    #[test]
-    fn tolerance_is_relative_to_dt() {
-        let text = "t,x,z\n0,0,0\n1,0,0\n2.0000009,0,0\n";
-        assert!(read_all(text).is_ok());
-        let text = "t,x,z\n0,0,0\n1,0,0\n2.0000011,0,0\n";
-        assert!(read_all(text).is_err());
-        let mut r = ResponseReader::new("d.csv", text.as_bytes(), 1e-5).unwrap();
-        while r.next_row().unwrap().is_some() {}
-        assert_eq!(r.rows(), 3);
-        assert_eq!(r.dt(), Some(1.0));
     }
 }

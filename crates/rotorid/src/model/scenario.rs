@@ -60,7 +60,7 @@ impl Sampling {
 }
 
 /// Initial displacement \[m\] and velocity \[m/s\] of the disk.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, serde::Deserialize)]
 pub struct InitialState {
     /// x(0) \[m\].
     pub x: f64,

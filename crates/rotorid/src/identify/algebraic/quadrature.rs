@@ -51,14 +51,18 @@ pub const LEVELS: usize = 4;
 pub enum Quadrature {
     /// Cumulative trapezoid rule, order 2 (what the paper's results suggest; for
     /// comparison): `h (f_{n+1} + f_n) / 2`.
+    #[serde(rename = "trapezoid")]
     Trapezoid,
     /// Adams-Moulton 2-step, order 3: `h (5 f_{n+1} + 8 f_n - f_{n-1}) / 12`.
+    #[serde(rename = "am3")]
     AdamsMoulton3,
     /// Adams-Moulton 3-step, order 4: `h (9 f_{n+1} + 19 f_n - 5 f_{n-1} + f_{n-2}) / 24`.
+    #[serde(rename = "am4")]
     AdamsMoulton4,
     /// Adams-Moulton 4-step, order 5 (the default):
     /// `h (251 f_{n+1} + 646 f_n - 264 f_{n-1} + 106 f_{n-2} - 19 f_{n-3}) / 720`.
     #[default]
+    #[serde(rename = "am5")]
     AdamsMoulton5,
 }
 

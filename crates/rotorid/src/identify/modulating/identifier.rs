@@ -359,6 +359,20 @@ impl ModulatingIdentifier {
         }
     }
 
+    /// The estimate once every sample is in: [`Self::estimate`], or
+    /// [`ModulatingError::RecordShorterThanWindow`] when not one window was completed.
+    pub fn finish(&self) -> Result<ModulatingEstimate, ModulatingError> {
+        if self.windows == 0 {
+            return Err(ModulatingError::RecordShorterThanWindow {
+                samples: self.samples() as usize,
+                needed: self.window_samples(),
+                window_s: self.window_s(),
+                dt: self.dt,
+            });
+        }
+        Ok(self.estimate())
+    }
+
     /// Restart from nothing (the next measurement is the first; its time may be anything).
     pub fn reset(&mut self) {
         self.open.clear();

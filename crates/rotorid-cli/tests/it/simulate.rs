@@ -2,9 +2,7 @@
 //! exactly, values that parse back to the library's own bits), the methods, the noise
 //! (reproducible from its seed) and the output file handling.
 
-mod common;
-
-use common::rotorid;
+use crate::common::rotorid;
 use rotorid::simulate::{simulate, Method};
 use rotorid::Scenario;
 

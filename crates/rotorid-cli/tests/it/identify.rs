@@ -3,14 +3,12 @@
 //! is whole rows, streamed as the input arrives, in bounded memory; `--every` and the
 //! summary JSON.
 
-mod common;
-
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command as Std, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use common::{data, rotorid};
+use crate::common::{data, param, rotorid};
 
 /// The table1 response (0.3 s, 3001 samples), simulated once per test binary.
 fn table1_csv() -> &'static str {
@@ -75,49 +73,47 @@ fn pipeline_recovers_table1_and_writes_every_summary_field() {
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
     for key in [
-        "format_version",
+        "schema",
         "input",
         "scenario",
         "method",
-        "quadrature",
-        "tol",
-        "rcond_min",
-        "samples",
-        "dt_s",
-        "t_first_s",
-        "t_last_s",
-        "final",
-        "final_time_s",
-        "identification_time_s",
-        "truth",
-        "relative_error",
-        "flagged",
-        "rows_written",
+        "record",
+        "parameters",
+        "rotor",
+        "diagnostics",
+        "algebraic",
     ] {
         assert!(s.get(key).is_some(), "summary lacks {key}: {s}");
     }
-    assert_eq!(s["samples"], 3001);
-    assert_eq!(s["rows_written"], 3001);
+    assert_eq!(s["schema"], 2);
+    assert_eq!(s["record"]["samples"], 3001);
+    assert_eq!(s["record"]["dt_s"], 1e-4);
     assert_eq!(s["method"], "algebraic");
     assert_eq!(s["input"], "-");
-    assert_eq!(s["truth"]["k_x"], 1.195e6);
-    for p in ["m_x", "c_x", "k_x", "m_z", "c_z", "k_z"] {
-        let e = s["relative_error"][p].as_f64().unwrap();
-        // method.md: ~1e-8 (m, k) and ~1e-6 (c) with a third-order rule on exact data.
+    assert_eq!(s["algebraic"]["quadrature"], "am5");
+    assert_eq!(param(&s, "kx")["truth"], 1.195e6);
+    for p in ["m_x", "cx", "kx", "m_z", "cz", "kz"] {
+        let r = param(&s, p);
+        assert_eq!(r["determined"], true, "{p}");
+        let e = r["relative_error"].as_f64().unwrap();
+        // exact data, 5th-order rule: ~1e-9 (m, k) and ~1e-7 (c) at 0.3 s.
         let bound = if p.starts_with('c') { 1e-4 } else { 1e-6 };
         assert!(e.abs() < bound, "{p}: relative error {e:e}");
-        let t = s["identification_time_s"][p].as_f64().unwrap();
+        let t = r["identification_time_s"].as_f64().unwrap();
         assert!(t < 0.02, "{p}: identification time {t}");
-        let f = s["final"][p].as_f64().unwrap();
-        let truth = s["truth"][p].as_f64().unwrap();
+        let f = r["value"].as_f64().unwrap();
+        let truth = r["truth"].as_f64().unwrap();
         assert!(((f - truth) / truth - e).abs() < 1e-15);
     }
     for d in ["x", "z"] {
         assert!(
-            s["flagged"][d].as_u64().unwrap() >= 3,
+            s["algebraic"]["flagged"][d].as_u64().unwrap() >= 3,
             "t_0 .. t_2 are singular"
         );
-        assert_eq!(s["final_time_s"][d].as_f64(), Some(3000.0 * 1e-4));
+        assert_eq!(
+            s["algebraic"]["final_time_s"][d].as_f64(),
+            Some(3000.0 * 1e-4)
+        );
     }
 
     // The last row of the CSV carries the final values, and parses back exactly.
@@ -128,8 +124,8 @@ fn pipeline_recovers_table1_and_writes_every_summary_field() {
         .split(',')
         .map(|f| f.parse().unwrap())
         .collect();
-    assert_eq!(last[1], s["final"]["m_x"].as_f64().unwrap());
-    assert_eq!(last[6], s["final"]["k_z"].as_f64().unwrap());
+    assert_eq!(last[1], param(&s, "m_x")["value"].as_f64().unwrap());
+    assert_eq!(last[6], param(&s, "kz")["value"].as_f64().unwrap());
 }
 
 #[test]
@@ -184,7 +180,9 @@ fn without_phi_columns_the_scenario_speed_gives_the_same_estimates() {
     assert_eq!(String::from_utf8(out.stdout).unwrap(), with_phi);
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
-    assert!(s["truth"].is_null() && s["relative_error"].is_null(), "{s}");
+    for p in s["parameters"].as_array().unwrap() {
+        assert!(p["truth"].is_null() && p["relative_error"].is_null(), "{s}");
+    }
 }
 
 #[test]
@@ -262,14 +260,11 @@ fn empty_file() {
 fn header_only_and_too_few_rows_say_how_many_are_needed() {
     let e = refused("t,x,z\n", &[]);
     assert!(
-        e.contains("<stdin>: 0 data rows after the header: the identifier needs at least 4"),
+        e.contains("<stdin>: 0 sample(s): algebraic needs at least 4"),
         "{e}"
     );
     let e = refused("t,x,z\n0,0,0\n0.1,0,0\n0.2,0,0\n", &[]);
-    assert!(
-        e.contains("3 data rows after the header: the identifier needs at least 4"),
-        "{e}"
-    );
+    assert!(e.contains("3 sample(s): algebraic needs at least 4"), "{e}");
     let (ok, out, _) = identify("t,x,z\n0,0,0\n0.1,0,0\n0.2,0,0\n", &[]);
     assert!(
         !ok && out.is_empty(),
@@ -325,7 +320,10 @@ fn nan_and_infinity() {
 #[test]
 fn time_not_strictly_increasing() {
     let e = refused(&format!("{GOOD}0.3,0,0\n"), &[]);
-    assert!(e.contains("line 6, column 1 (t): time is not strictly increasing: t = 0.3 s follows t = 0.3 s (line 5)"), "{e}");
+    assert!(
+        e.contains("line 6: sample 4: t = 0.3 s is not after the previous sample's t = 0.3 s"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -334,7 +332,7 @@ fn non_uniform_sampling_states_the_tolerance_and_can_be_relaxed() {
     let jitter = "t,x,z\n0,0,0\n1,1,2\n2,3,1\n3,2,-1\n4.00001,1,1\n5,0,0\n";
     let e = refused(jitter, &[]);
     assert!(
-        e.contains("line 6, column 1 (t): sampling is not uniform"),
+        e.contains("line 6: sample 4: sampling is not uniform: t = 4.00001 s"),
         "{e}"
     );
     assert!(e.contains("the allowed deviation is 1e-6 of dt"), "{e}");

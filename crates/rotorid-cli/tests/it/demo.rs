@@ -1,9 +1,7 @@
 //! End-to-end test of `rotorid demo`: it runs, prints every parameter in both settings, and
 //! its JSON agrees with the accuracy the method promises on exact data.
 
-mod common;
-
-use common::rotorid;
+use crate::common::rotorid;
 
 #[test]
 fn demo_prints_every_parameter_in_both_settings() {

@@ -2,11 +2,9 @@
 //! the HTML is self-contained, and results.json holds every case, setting, parameter and
 //! direction with numbers that only a working simulator + identifier would give.
 
-mod common;
-
 use std::path::Path;
 
-use common::rotorid;
+use crate::common::rotorid;
 use serde_json::Value;
 
 fn png_size(path: &Path) -> (u32, u32) {

@@ -2,9 +2,7 @@
 //! mistake (unknown key, missing key, wrong type, out-of-range value, bad TOML) is refused
 //! with a message naming the file, the line and the key, with a non-zero exit and no panic.
 
-mod common;
-
-use common::{data, rotorid};
+use crate::common::{data, rotorid};
 
 fn simulate(scenario: &str, extra: &[&str]) -> std::process::Output {
     rotorid()
@@ -84,8 +82,10 @@ fn the_ramp_example_simulates_and_identifies() {
     );
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
-    for p in ["m_x", "k_x", "m_z", "k_z"] {
-        let e = s["relative_error"][p].as_f64().unwrap();
+    for p in ["m_x", "kx", "m_z", "kz"] {
+        let e = crate::common::param(&s, p)["relative_error"]
+            .as_f64()
+            .unwrap();
         assert!(
             e.abs() < 1e-6,
             "{p}: {e:e} (non-zero initial state must not matter)"

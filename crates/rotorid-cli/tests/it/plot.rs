@@ -2,11 +2,9 @@
 //! scenario, honours a time window, and fails clearly on an unknown header, a bad
 //! extension or an empty window.
 
-mod common;
-
 use std::path::Path;
 
-use common::rotorid;
+use crate::common::rotorid;
 use predicates::str::contains;
 
 fn png_size(path: &Path) -> (u32, u32) {

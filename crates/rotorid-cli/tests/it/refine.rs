@@ -6,11 +6,9 @@
 //! names with the list of allowed ones; the start falls back to the algebraic estimate on
 //! a record shorter than one modulating window.
 
-mod common;
-
 use std::sync::OnceLock;
 
-use common::{data, identify_with_summary, rotorid, simulate, Run};
+use crate::common::{data, identify_with_summary, param, rotorid, simulate, state, Run};
 use serde_json::Value;
 
 /// table1, 0.3 s (3001 samples), clean.
@@ -85,17 +83,17 @@ fn recovers_table1_within_a_few_std_errors_at_the_cramer_rao_bound() {
     assert!(r.ok, "{}", r.stderr);
     let s = r.summary.unwrap();
     assert_eq!(s["method"], "refine");
-    assert_eq!(s["samples"], 3001);
-    assert_eq!(s["start"]["source"], "modulating");
-    assert_eq!(s["crb_at"], "truth");
-    assert_eq!(s["identifiable"], true);
-    assert_eq!(s["converged"], true);
-    assert_eq!(s["warnings"], Value::Array(vec![]));
-    assert!(s["quadrature"].is_null() && s["tol"].is_null());
+    assert_eq!(s["record"]["samples"], 3001);
+    assert_eq!(s["refine"]["start"]["source"], "modulating");
+    assert_eq!(s["refine"]["crb_at"], "truth");
+    assert_eq!(s["refine"]["identifiable"], true);
+    assert_eq!(s["refine"]["converged"], true);
+    assert_eq!(s["diagnostics"], Value::Array(vec![]));
+    assert!(s["algebraic"].is_null());
     for (name, truth) in TABLE1 {
-        let v = s["estimate"][name].as_f64().unwrap();
-        let se = s["std_error"][name].as_f64().unwrap();
-        let crb = s["crb"][name].as_f64().unwrap();
+        let v = param(&s, name)["estimate"].as_f64().unwrap();
+        let se = param(&s, name)["std_error"].as_f64().unwrap();
+        let crb = param(&s, name)["crb"].as_f64().unwrap();
         let z = (v - truth) / se;
         assert!(
             z.abs() < 4.0,
@@ -107,35 +105,35 @@ fn recovers_table1_within_a_few_std_errors_at_the_cramer_rao_bound() {
             (se / crb - 1.0).abs() < 0.05,
             "{name}: std error {se:e}, CRB {crb:e}"
         );
-        let rel = s["relative_std_error"][name].as_f64().unwrap();
+        let rel = param(&s, name)["relative_std_error"].as_f64().unwrap();
         assert!((rel - se / v.abs()).abs() <= 1e-12 * rel);
     }
     // method.md section 7 (state known, 0.3 s): m 9.9e-5, k 1.0e-4; estimating the initial
     // state too costs a little more.
-    let rel_m = s["relative_std_error"]["m"].as_f64().unwrap();
+    let rel_m = param(&s, "m")["relative_std_error"].as_f64().unwrap();
     assert!(
         (9.9e-5..3e-4).contains(&rel_m),
         "relative std error of m {rel_m:e}"
     );
     // The noise: sigma = RMS(clean channel) * 10^(-40/20).
-    for (ch, col) in [("sigma_x", 1), ("sigma_z", 2)] {
+    assert_eq!(s["noise"]["source"], "residuals");
+    for (ch, col) in [("sigma_x_m", 1), ("sigma_z_m", 2)] {
         let want = rms(&column(table1_clean(), col)) * 1e-2;
-        let got = s[ch].as_f64().unwrap();
+        let got = s["noise"][ch].as_f64().unwrap();
         assert!((got / want - 1.0).abs() < 0.05, "{ch} {got:e} vs {want:e}");
     }
     for ic in ["x0", "z0", "vx0", "vz0"] {
-        let v = s["initial_state"][ic].as_f64().unwrap();
-        let se = s["initial_state_std_error"][ic].as_f64().unwrap();
+        let v = state(&s, ic)["value"].as_f64().unwrap();
+        let se = state(&s, ic)["std_error"].as_f64().unwrap();
         assert!(v.abs() < 4.0 * se, "{ic} = {v:e} +- {se:e}, truth 0");
     }
     // One row at the last sample, m in both directions, equal to the summary's final.
     let row = estimates_row(&r.csv);
     assert_eq!(row[0], Some(0.3));
     assert_eq!(row[1], row[4]);
-    same(row[1], &s["final"]["m_x"]);
-    same(row[1], &s["estimate"]["m"]);
-    same(row[6], &s["estimate"]["kz"]);
-    assert_eq!(s["rows_written"], 1);
+    same(row[1], &param(&s, "m")["value"]);
+    same(row[1], &param(&s, "m")["estimate"]);
+    same(row[6], &param(&s, "kz")["estimate"]);
     // The table on stderr: value +- std error, relative std error, CRB; no warning.
     assert!(r.stderr.contains("+- std err") && r.stderr.contains("CRB"));
     assert!(!r.stderr.contains("warning:"), "{}", r.stderr);
@@ -195,21 +193,24 @@ fn a_record_without_excitation_is_not_identifiable_and_gives_no_confident_number
         r.stderr
     );
     let s = r.summary.unwrap();
-    assert_eq!(s["identifiable"], false);
-    assert!(!s["warnings"].as_array().unwrap().is_empty());
+    assert_eq!(s["refine"]["identifiable"], false);
+    assert!(!s["diagnostics"].as_array().unwrap().is_empty());
     for (name, _) in TABLE1 {
         // Infinite (null) or larger than the value itself: never a confident number.
-        let rel = s["relative_std_error"][name].as_f64();
+        let rel = param(&s, name)["relative_std_error"].as_f64();
         assert!(
             rel.is_none_or(|r| r > 1.0),
             "{name}: relative std error {rel:?}"
         );
     }
-    for p in ["m_x", "c_x", "k_x", "m_z", "c_z", "k_z"] {
-        assert!(s["final"][p].is_null(), "{p} = {}", s["final"][p]);
+    for p in ["m", "cx", "kx", "cz", "kz"] {
+        let r = param(&s, p);
+        assert!(
+            r["value"].is_null() && r["determined"] == false,
+            "{p} = {r}"
+        );
     }
-    assert_eq!(s["flagged"]["x"], 1);
-    assert_eq!(s["flagged"]["z"], 1);
+    assert!(s["rotor"].is_null());
     let row = estimates_row(&r.csv);
     assert!(row[1..7].iter().all(Option::is_none), "{}", r.csv);
 }
@@ -273,14 +274,17 @@ fn without_truth_the_bound_is_at_the_estimate() {
     let r = refine(table1_noisy(), &data("known_only.toml"), &[]);
     assert!(r.ok, "{}", r.stderr);
     let s = r.summary.unwrap();
-    assert_eq!(s["crb_at"], "estimate");
-    assert!(s["truth"].is_null() && s["relative_error"].is_null());
+    assert_eq!(s["refine"]["crb_at"], "estimate");
+    for (name, _) in TABLE1 {
+        let r = param(&s, name);
+        assert!(r["truth"].is_null() && r["relative_error"].is_null(), "{r}");
+    }
     for (name, truth) in TABLE1 {
-        let v = s["estimate"][name].as_f64().unwrap();
-        let se = s["std_error"][name].as_f64().unwrap();
+        let v = param(&s, name)["estimate"].as_f64().unwrap();
+        let se = param(&s, name)["std_error"].as_f64().unwrap();
         assert!(((v - truth) / se).abs() < 4.0, "{name} = {v} +- {se}");
         // At the estimate the bound is the standard error itself.
-        let crb = s["crb"][name].as_f64().unwrap();
+        let crb = param(&s, name)["crb"].as_f64().unwrap();
         assert!((crb / se - 1.0).abs() < 1e-6, "{name}: {crb:e} vs {se:e}");
     }
 }
@@ -294,17 +298,17 @@ fn the_unbalance_can_be_estimated_with_cx_cz_known() {
     );
     assert!(r.ok, "{}", r.stderr);
     let s = r.summary.unwrap();
-    let mut names: Vec<&str> = s["estimate"]
-        .as_object()
+    let mut names: Vec<&str> = s["parameters"]
+        .as_array()
         .unwrap()
-        .keys()
-        .map(String::as_str)
+        .iter()
+        .map(|p| p["parameter"].as_str().unwrap())
         .collect();
     names.sort_unstable();
     assert_eq!(names, ["alpha", "kx", "kz", "m", "mud"]);
     assert_eq!(
-        s["unknowns"],
-        serde_json::json!(["m", "kx", "kz", "unbalance"])
+        s["refine"]["unknowns"],
+        serde_json::json!(["m", "kx", "kz", "mud", "alpha"])
     );
     for (name, truth) in [
         ("m", 14.29),
@@ -313,12 +317,12 @@ fn the_unbalance_can_be_estimated_with_cx_cz_known() {
         ("mud", 1e-4 * 0.15),
         ("alpha", std::f64::consts::FRAC_PI_4),
     ] {
-        let v = s["estimate"][name].as_f64().unwrap();
-        let se = s["std_error"][name].as_f64().unwrap();
+        let v = param(&s, name)["estimate"].as_f64().unwrap();
+        let se = param(&s, name)["std_error"].as_f64().unwrap();
         assert!(((v - truth) / se).abs() < 4.0, "{name} = {v} +- {se}");
     }
     // cx, cz were known: not identified, so not in `final` nor in the CSV.
-    assert!(s["final"]["c_x"].is_null() && s["final"]["c_z"].is_null());
+    assert!(param(&s, "cx")["value"].is_null() && param(&s, "cz")["value"].is_null());
     let row = estimates_row(&r.csv);
     assert!(row[1].is_some() && row[2].is_none() && row[5].is_none());
 }
@@ -337,11 +341,10 @@ fn a_record_shorter_than_a_window_starts_from_the_algebraic_estimate_at_50_ms() 
     let r = refine(&head(table1_noisy(), 801), "table1", &["--window", "0.1"]);
     assert!(r.ok, "{}", r.stderr);
     let s = r.summary.unwrap();
-    assert_eq!(s["start"]["source"], "algebraic");
-    assert_eq!(s["start"]["t_s"], 0.05);
-    assert_eq!(s["quadrature"], "am5");
+    assert_eq!(s["refine"]["start"]["source"], "algebraic");
+    assert_eq!(s["refine"]["start"]["t_s"], 0.05);
     assert!(s["modulating"].is_null());
-    let note = s["start"]["note"].as_str().unwrap();
+    let note = s["refine"]["start"]["note"].as_str().unwrap();
     assert!(
         note.contains("the record has 801 samples but one window needs 1001"),
         "{note}"
@@ -349,10 +352,10 @@ fn a_record_shorter_than_a_window_starts_from_the_algebraic_estimate_at_50_ms() 
     assert!(r
         .stderr
         .contains("start: algebraic estimate at t = 0.05000 s"));
-    assert_eq!(s["identifiable"], true);
+    assert_eq!(s["refine"]["identifiable"], true);
     for (name, truth) in TABLE1 {
-        let v = s["estimate"][name].as_f64().unwrap();
-        let se = s["std_error"][name].as_f64().unwrap();
+        let v = param(&s, name)["estimate"].as_f64().unwrap();
+        let se = param(&s, name)["std_error"].as_f64().unwrap();
         assert!(((v - truth) / se).abs() < 4.0, "{name} = {v} +- {se}");
     }
 }
@@ -364,17 +367,17 @@ fn a_very_short_record_withholds_the_damping_it_cannot_determine() {
     let r = refine(&head(table1_noisy(), 151), "table1", &[]);
     assert!(r.ok, "{}", r.stderr);
     let s = r.summary.unwrap();
-    assert!(s["start"]["note"]
+    assert!(s["refine"]["start"]["note"]
         .as_str()
         .unwrap()
         .contains("one window needs"));
-    let m = s["estimate"]["m"].as_f64().unwrap();
-    let se = s["std_error"]["m"].as_f64().unwrap();
+    let m = param(&s, "m")["estimate"].as_f64().unwrap();
+    let se = param(&s, "m")["std_error"].as_f64().unwrap();
     assert!(
         ((m - 14.29) / se).abs() < 4.0 && se / m < 0.05,
         "m = {m} +- {se}"
     );
-    assert_eq!(s["identifiable"], false);
+    assert_eq!(s["refine"]["identifiable"], false);
     assert!(
         r.stderr.contains("warning: NOT IDENTIFIABLE"),
         "{}",
@@ -388,8 +391,8 @@ fn a_very_short_record_withholds_the_damping_it_cannot_determine() {
     let row = estimates_row(&r.csv);
     assert!(row[1].is_some() && row[3].is_some(), "m_x, k_x determined");
     assert!(row[2].is_none() && row[5].is_none(), "c_x, c_z withheld");
-    assert!(s["final"]["c_x"].is_null() && s["final"]["k_x"].is_number());
-    assert_eq!(s["flagged"]["x"], 1);
+    assert!(param(&s, "cx")["value"].is_null() && param(&s, "kx")["value"].is_number());
+    assert_eq!(param(&s, "cx")["determined"], false);
 }
 
 #[test]
@@ -405,12 +408,15 @@ fn a_ramp_with_measured_speed_uses_the_scenario_initial_state_for_the_bound() {
     let r = refine(&csv, &data("table1_ramp.toml"), &[]);
     assert!(r.ok, "{}", r.stderr);
     let s = r.summary.unwrap();
-    assert!(s["discretisation"].as_str().unwrap().starts_with("RK4"));
-    assert_eq!(s["crb_at"], "truth");
+    assert!(s["refine"]["discretisation"]
+        .as_str()
+        .unwrap()
+        .starts_with("RK4"));
+    assert_eq!(s["refine"]["crb_at"], "truth");
     for (name, truth) in TABLE1 {
-        let v = s["estimate"][name].as_f64().unwrap();
-        let se = s["std_error"][name].as_f64().unwrap();
-        let crb = s["crb"][name].as_f64().unwrap();
+        let v = param(&s, name)["estimate"].as_f64().unwrap();
+        let se = param(&s, name)["std_error"].as_f64().unwrap();
+        let crb = param(&s, name)["crb"].as_f64().unwrap();
         assert!(((v - truth) / se).abs() < 4.0, "{name} = {v} +- {se}");
         // Bound at the scenario's (off-centre) initial state: a wrong initial state would
         // change the free transient and the bound by far more than 5 %.
@@ -421,8 +427,8 @@ fn a_ramp_with_measured_speed_uses_the_scenario_initial_state_for_the_bound() {
     }
     // The fitted initial state is the scenario's [initial].
     for (ic, truth) in [("x0", 2e-7), ("z0", -1e-7), ("vx0", 1e-4), ("vz0", 5e-5)] {
-        let v = s["initial_state"][ic].as_f64().unwrap();
-        let se = s["initial_state_std_error"][ic].as_f64().unwrap();
+        let v = state(&s, ic)["value"].as_f64().unwrap();
+        let se = state(&s, ic)["std_error"].as_f64().unwrap();
         assert!(((v - truth) / se).abs() < 4.0, "{ic} = {v:e} +- {se:e}");
     }
 }
@@ -439,12 +445,12 @@ fn a_record_starting_later_bounds_at_the_true_parameters_and_fitted_state() {
     let r = refine(&late, "table1", &[]);
     assert!(r.ok, "{}", r.stderr);
     let s = r.summary.unwrap();
-    assert_eq!(s["samples"], 2001);
-    assert_eq!(s["t_first_s"], 0.1);
-    assert_eq!(s["crb_at"], "truth_parameters");
+    assert_eq!(s["record"]["samples"], 2001);
+    assert_eq!(s["record"]["t_first_s"], 0.1);
+    assert_eq!(s["refine"]["crb_at"], "truth_parameters");
     for (name, truth) in TABLE1 {
-        let v = s["estimate"][name].as_f64().unwrap();
-        let se = s["std_error"][name].as_f64().unwrap();
+        let v = param(&s, name)["estimate"].as_f64().unwrap();
+        let se = param(&s, name)["std_error"].as_f64().unwrap();
         assert!(((v - truth) / se).abs() < 4.0, "{name} = {v} +- {se}");
     }
 }

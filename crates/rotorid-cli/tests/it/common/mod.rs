@@ -1,24 +1,21 @@
-//! Helpers shared by the end-to-end tests in `tests/cli_*.rs`: the `rotorid` command, the
+//! Helpers shared by the end-to-end tests in `tests/it/`: the `rotorid` command, the
 //! path of a file in `tests/data`, a `simulate` run to a CSV string and an `identify` run
-//! that also reads back its summary JSON. Each test binary uses only some of them.
+//! that also reads back its summary JSON.
 
 use assert_cmd::Command;
 use serde_json::Value;
 
 /// The `rotorid` binary of this build.
-#[allow(dead_code)]
 pub fn rotorid() -> Command {
     Command::cargo_bin("rotorid").expect("the rotorid binary is built")
 }
 
 /// Path of `tests/data/NAME`.
-#[allow(dead_code)]
 pub fn data(name: &str) -> String {
     format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
 /// `simulate ARGS --out -`: the response CSV.
-#[allow(dead_code)]
 pub fn simulate(args: &[&str]) -> String {
     let out = rotorid()
         .arg("simulate")
@@ -35,7 +32,6 @@ pub fn simulate(args: &[&str]) -> String {
 }
 
 /// The result of one `identify` run.
-#[allow(dead_code)]
 pub struct Run {
     pub ok: bool,
     pub csv: String,
@@ -45,7 +41,6 @@ pub struct Run {
 
 /// `identify - OPTIONS --summary S ARGS` on `input`, S a temporary file read back as JSON
 /// (`None` if the run wrote none). Panics if the binary panicked.
-#[allow(dead_code)]
 pub fn identify_with_summary(input: &str, options: &[&str], args: &[&str]) -> Run {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("s.json");
@@ -67,4 +62,21 @@ pub fn identify_with_summary(input: &str, options: &[&str], args: &[&str]) -> Ru
             .ok()
             .map(|t| serde_json::from_str(&t).unwrap()),
     }
+}
+
+/// The entry of parameter `name` (`m`, `m_x`, `cx`, ...) in a summary's `parameters`, or
+/// JSON null.
+pub fn param<'a>(summary: &'a Value, name: &str) -> &'a Value {
+    summary["parameters"]
+        .as_array()
+        .and_then(|a| a.iter().find(|p| p["parameter"] == name))
+        .unwrap_or(&Value::Null)
+}
+
+/// The entry of initial-state component `name` (x0, z0, vx0, vz0) of a refine summary.
+pub fn state<'a>(summary: &'a Value, name: &str) -> &'a Value {
+    summary["refine"]["initial_state"]
+        .as_array()
+        .and_then(|a| a.iter().find(|p| p["name"] == name))
+        .unwrap_or(&Value::Null)
 }

@@ -1,0 +1,311 @@
+//! The input-to-output plumbing of `rotorid identify`: rows of the response CSV go into a
+//! `rotorid::pipeline::Session` as they are read, the algebraic estimates come out as
+//! rows of the estimates CSV (every `--every`-th), the batch methods' one row is written
+//! at the end. Memory stays bounded for the streaming methods whatever the input length.
+//!
+//! A live input (stdin, a pipe or FIFO) gets its estimates as soon as its samples arrive:
+//! just before a read that may block, the output is flushed and the session starts on the
+//! samples it holds (its time grid is then fitted over those; a regular file's over the
+//! first `DEFAULT_GRID_HEAD` stamps).
+
+use std::cell::RefCell;
+use std::io::{self, Read, Write};
+use std::rc::Rc;
+
+use anyhow::Context as _;
+use rotorid::pipeline::{
+    Identification, Knowledge, Method, PipelineError, Sample, SampleEstimate, Session, Timing,
+    DEFAULT_GRID_HEAD,
+};
+use rotorid::SpeedProfile;
+
+use crate::io::{
+    CsvError, EstimateRow, EstimatesWriter, Output, ParameterSet, ResponseReader, ScenarioSpec,
+};
+
+/// Names and options of one run.
+pub(crate) struct Io<'a> {
+    /// The input's name in messages.
+    pub name: &'a str,
+    /// The output's name in messages.
+    pub out_name: &'a str,
+    /// Whether reads may block (stdin, pipe, FIFO).
+    pub live: bool,
+    /// Write every N-th algebraic estimate.
+    pub every: u64,
+}
+
+/// What the reader's pre-read hook and the row loop share.
+struct State {
+    session: Session,
+    rows: Rows,
+}
+
+/// Where the algebraic estimates go: every `every`-th as a row of the estimates CSV.
+struct Rows {
+    /// The output until the first row is written (then inside `writer`): nothing, not even
+    /// the header, is written for an input that gives no estimate.
+    out: Option<Output>,
+    writer: Option<EstimatesWriter<Output>>,
+    /// Estimates seen (the `--every` counter).
+    seen: u64,
+    every: u64,
+    /// The first write error (a session's sink cannot return one).
+    error: Option<io::Error>,
+}
+
+impl Rows {
+    fn write(&mut self, e: &SampleEstimate) {
+        let n = self.seen;
+        self.seen += 1;
+        if n % self.every != 0 || self.error.is_some() {
+            return;
+        }
+        if self.writer.is_none() {
+            match self.out.take().map(EstimatesWriter::new) {
+                Some(Ok(w)) => self.writer = Some(w),
+                Some(Err(err)) => self.error = Some(err),
+                None => {}
+            }
+        }
+        if let Some(w) = self.writer.as_mut() {
+            if let Err(err) = w.write(&row_of(e)) {
+                self.error = Some(err);
+            }
+        }
+    }
+
+    /// The output back, with what was written.
+    fn into_output(self) -> Option<Output> {
+        self.writer.map(EstimatesWriter::into_inner).or(self.out)
+    }
+}
+
+impl State {
+    fn push(&mut self, s: &Sample) -> Result<(), PipelineError> {
+        let rows = &mut self.rows;
+        self.session.push(s, &mut |e| rows.write(e))
+    }
+
+    /// Flush, and on a live input start the session on what it holds.
+    fn before_read(&mut self, live: bool) -> io::Result<()> {
+        if live {
+            let rows = &mut self.rows;
+            // a grid error here surfaces again at the next push or at the end
+            let _ = self.session.start_now(&mut |e| rows.write(e));
+        }
+        if let Some(e) = self.rows.error.take() {
+            return Err(e);
+        }
+        match self.rows.writer.as_mut() {
+            Some(w) => w.flush(),
+            None => Ok(()),
+        }
+    }
+}
+
+/// An input that calls `State::before_read` before each read of the underlying input.
+struct HookedInput<R> {
+    inner: R,
+    state: Rc<RefCell<State>>,
+    live: bool,
+}
+
+impl<R: Read> Read for HookedInput<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        if let Ok(mut s) = self.state.try_borrow_mut() {
+            s.before_read(self.live)?;
+        }
+        self.inner.read(buf)
+    }
+}
+
+/// Read `input`, identify it by `method` with what `spec` knows, write the estimates CSV
+/// to `out` (committed on success; complete rows on error) and return the result.
+pub(crate) fn identify(
+    io: &Io,
+    input: Box<dyn Read>,
+    out: Output,
+    spec: &ScenarioSpec,
+    method: &Method,
+    time_tolerance: f64,
+) -> anyhow::Result<Identification> {
+    let (knowledge, profile) = knowledge(spec)?;
+    let timing = Timing::Fit {
+        head: DEFAULT_GRID_HEAD,
+        tolerance: time_tolerance,
+    };
+    let session = Session::new(&knowledge, method, profile, timing)
+        .map_err(|e| CsvError::file(io.name, e.to_string()))?;
+    // The algebraic method writes a row per estimate as it goes, the others one at the end.
+    let algebraic = matches!(method, Method::Algebraic(_));
+    let (out, held) = if algebraic {
+        (Some(out), None)
+    } else {
+        (None, Some(out))
+    };
+    let state = Rc::new(RefCell::new(State {
+        session,
+        rows: Rows {
+            out,
+            writer: None,
+            seen: 0,
+            every: io.every,
+            error: None,
+        },
+    }));
+    let hooked = HookedInput {
+        inner: input,
+        state: Rc::clone(&state),
+        live: io.live,
+    };
+    let result = read_all(io, hooked, &state, profile);
+    let State { session, mut rows } = Rc::try_unwrap(state)
+        .map_err(|_| anyhow::anyhow!("the input still holds the session"))?
+        .into_inner();
+    let finished = result.and_then(|()| {
+        session
+            .finish(&mut |e| rows.write(e))
+            .map_err(|e| CsvError::file(io.name, finish_error(e, spec.origin())).into())
+    });
+    if let Some(e) = rows.error.take() {
+        return Err(e).with_context(|| format!("cannot write {}", io.out_name));
+    }
+    // After an error, keep the whole rows written so far.
+    let Some(mut out) = rows.into_output().or(held) else {
+        anyhow::bail!("no output for {}", io.out_name);
+    };
+    let ident = match finished {
+        Ok(i) => i,
+        Err(e) => {
+            let _ = out.flush();
+            return Err(e);
+        }
+    };
+    if let Some(f) = ident.final_estimate() {
+        let v = f.values;
+        let mut w = EstimatesWriter::new(&mut out)
+            .with_context(|| format!("cannot write {}", io.out_name))?;
+        w.write(&EstimateRow {
+            t: f.t_s,
+            values: ParameterSet::from_array(v),
+            rcond_x: f.rcond.x,
+            rcond_z: f.rcond.z,
+        })
+        .with_context(|| format!("cannot write {}", io.out_name))?;
+    }
+    out.commit()?;
+    Ok(ident)
+}
+
+/// Every row of `reader` into the session.
+fn read_all<R: Read>(
+    io: &Io,
+    input: HookedInput<R>,
+    state: &Rc<RefCell<State>>,
+    profile: Option<SpeedProfile>,
+) -> anyhow::Result<()> {
+    let mut reader = ResponseReader::new(io.name, input)?;
+    if !reader.has_phi() && profile.is_none() {
+        return Err(CsvError::file(
+            io.name,
+            "has no phi, phi_dot, phi_ddot columns and the scenario has no [speed] section: \
+             give the rotor angle in the data or the speed profile in the scenario"
+                .to_owned(),
+        )
+        .into());
+    }
+    while let Some(row) = reader.next_row()? {
+        let s = Sample {
+            t: Some(row.t),
+            x: row.x,
+            z: row.z,
+            speed: row.speed,
+        };
+        let mut st = state.borrow_mut();
+        st.push(&s).map_err(|e| {
+            let hint = match e {
+                PipelineError::NonUniformSampling { .. } => " (--time-tolerance)",
+                _ => "",
+            };
+            CsvError::line(io.name, row.line, format!("{e}{hint}"))
+        })?;
+        if let Some(e) = st.rows.error.take() {
+            return Err(e).with_context(|| format!("cannot write {}", io.out_name));
+        }
+    }
+    Ok(())
+}
+
+/// The message of an error at the end of the input, in the command's terms (its options
+/// and the scenario file `scenario`).
+fn finish_error(e: PipelineError, scenario: &str) -> String {
+    let rotor_keys = |names: &str| names.replace(", ", ", rotor.");
+    match e {
+        PipelineError::Modulating(m) => format!("{m} (--window)"),
+        PipelineError::KnownValueMissing { missing } => format!(
+            "--unknowns leaves {missing} known, but the scenario {scenario} does not state \
+             rotor.{}: give the known values in the scenario or add them to --unknowns",
+            rotor_keys(&missing)
+        ),
+        PipelineError::NoStart { why, missing } => format!(
+            "refine has no starting point: {why}; the scenario {scenario} does not state \
+             rotor.{} to start from. The record may not excite the rotor at all; give \
+             nominal values in the scenario to let the fit say what the record can determine",
+            rotor_keys(&missing)
+        ),
+        e => e.to_string(),
+    }
+}
+
+/// The estimates CSV row of one algebraic estimate: m, c, k only where well conditioned.
+fn row_of(e: &SampleEstimate) -> EstimateRow {
+    let est = &e.estimate;
+    let ok = e.well_conditioned;
+    let keep = |v: f64, ok: bool| (ok && v.is_finite()).then_some(v);
+    EstimateRow {
+        t: est.t,
+        values: ParameterSet {
+            m_x: keep(est.x.m, ok[0]),
+            c_x: keep(est.x.c, ok[0]),
+            k_x: keep(est.x.k, ok[0]),
+            m_z: keep(est.z.m, ok[1]),
+            c_z: keep(est.z.c, ok[1]),
+            k_z: keep(est.z.k, ok[1]),
+        },
+        rcond_x: est.x.rcond,
+        rcond_z: est.z.rcond,
+    }
+}
+
+/// What the scenario tells the pipeline: the known a and unbalance, its m, c, k as
+/// nominal values and truth (with its initial state when it describes a whole
+/// simulation), and its speed profile.
+fn knowledge(spec: &ScenarioSpec) -> anyhow::Result<(Knowledge, Option<SpeedProfile>)> {
+    let v = spec.identification()?;
+    let t = &v.truth;
+    let values = rotorid::pipeline::RotorValues {
+        m: t.m,
+        cx: t.cx,
+        kx: t.kx,
+        cz: t.cz,
+        kz: t.kz,
+    };
+    let ov = crate::io::SimulationOverrides {
+        dt: Some(1.0),
+        duration: Some(1.0),
+        ..Default::default()
+    };
+    let initial = spec.simulation(&ov).ok().map(|s| s.initial);
+    let k = Knowledge {
+        a: v.a,
+        unbalance: rotorid::Unbalance {
+            m_u: v.m_u,
+            d: v.d,
+            alpha: v.alpha,
+        },
+        nominal: values,
+        truth: (!t.is_empty()).then_some(rotorid::pipeline::Truth { values, initial }),
+    };
+    Ok((k, v.speed))
+}

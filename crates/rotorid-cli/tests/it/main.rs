@@ -1,0 +1,13 @@
+//! The `rotorid` command end to end (one test binary: `cargo test -p rotorid-cli --test it`).
+
+mod common;
+
+mod demo;
+mod golden;
+mod identify;
+mod modulating;
+mod paper;
+mod plot;
+mod refine;
+mod scenario;
+mod simulate;

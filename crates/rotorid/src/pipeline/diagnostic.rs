@@ -1,0 +1,241 @@
+//! What a user should read before trusting the numbers: one typed diagnostic per finding,
+//! each with a message that says what was found and what to do about it. Every caller
+//! prints them the same way (the CLI as `warning: ...` lines, Python as `res.warnings`).
+
+use serde::{Deserialize, Serialize};
+
+use crate::refine::Warning;
+
+/// x (horizontal) or z (vertical).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// Horizontal.
+    X,
+    /// Vertical.
+    Z,
+}
+
+impl Direction {
+    /// `x` or `z`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Direction::X => "x",
+            Direction::Z => "z",
+        }
+    }
+}
+
+/// One value per direction.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Directions<T> {
+    /// x (horizontal).
+    pub x: T,
+    /// z (vertical).
+    pub z: T,
+}
+
+/// How much a diagnostic matters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Severity {
+    /// The numbers it concerns must not be relied on as they stand.
+    Warning,
+    /// Worth knowing; the numbers stand.
+    Note,
+}
+
+/// What was found (the data of a [`Diagnostic`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Finding {
+    /// The data carry no information on these quantities (alone or in combination).
+    NotIdentifiable {
+        /// Their names (parameters and initial-state components).
+        quantities: Vec<String>,
+    },
+    /// The unknowns are so strongly correlated that the standard errors are unreliable.
+    IllConditioned {
+        /// Condition number of the scaled Fisher information.
+        condition_number: f64,
+        /// The limit it exceeds.
+        limit: f64,
+    },
+    /// A standard error above the value itself (or 1 rad for alpha).
+    PoorlyDetermined {
+        /// The quantity.
+        quantity: String,
+        /// Standard error over |value| (for alpha: the standard error, rad).
+        relative_std_error: f64,
+    },
+    /// The fit stopped at its iteration limit.
+    NotConverged {
+        /// Model passes made.
+        iterations: usize,
+        /// Last Gauss-Newton step in standard errors.
+        last_step: f64,
+    },
+    /// Constant speed and no significant free transient: only the steady state informs
+    /// the fit.
+    NoSignificantTransient {
+        /// The transient's size in standard errors.
+        significance: f64,
+    },
+    /// An estimate outside the model's physical range.
+    Unphysical {
+        /// The quantity.
+        quantity: String,
+        /// Its value.
+        value: f64,
+    },
+    /// A direction of the modulating least squares is ill-conditioned; its m, c, k are
+    /// withheld.
+    DirectionIllConditioned {
+        /// The direction.
+        direction: Direction,
+        /// Its reciprocal condition number.
+        rcond: f64,
+        /// The threshold.
+        rcond_min: f64,
+    },
+    /// A direction of the modulating least squares is singular; its m, c, k are withheld.
+    DirectionSingular {
+        /// The direction.
+        direction: Direction,
+    },
+    /// A stream's grid, fitted over its first stamps, differs from the fit of all of them
+    /// by more than 1e-6 dt: the estimates are biased by about twice that.
+    TimeGridDrift {
+        /// The period used \[s\].
+        dt_used_s: f64,
+        /// The period of all stamps \[s\].
+        dt_all_s: f64,
+        /// Stamps the used period was fitted over.
+        fitted_over: usize,
+        /// All stamps.
+        samples: usize,
+    },
+    /// The Cramer-Rao bound could not be computed.
+    CrbUnavailable {
+        /// Why.
+        reason: String,
+    },
+}
+
+/// A finding with its severity and message (module doc).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Diagnostic {
+    /// What was found.
+    #[serde(flatten)]
+    pub finding: Finding,
+    /// How much it matters.
+    pub severity: Severity,
+    /// One sentence: what, and what to do about it.
+    pub message: String,
+}
+
+impl Diagnostic {
+    /// The diagnostic of one of the pipeline's own findings, with its message.
+    pub(crate) fn new(finding: Finding) -> Self {
+        let message = message(&finding);
+        Self {
+            finding,
+            severity: Severity::Warning,
+            message,
+        }
+    }
+
+    /// True for findings that say the data cannot separate the unknowns.
+    pub fn inseparable(&self) -> bool {
+        matches!(
+            self.finding,
+            Finding::NotIdentifiable { .. } | Finding::IllConditioned { .. }
+        )
+    }
+}
+
+impl std::fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl From<&Warning> for Diagnostic {
+    fn from(w: &Warning) -> Self {
+        let finding = match w {
+            Warning::NotIdentifiable { parameters } => Finding::NotIdentifiable {
+                quantities: parameters.iter().map(|s| (*s).to_owned()).collect(),
+            },
+            Warning::IllConditioned {
+                condition_number,
+                limit,
+            } => Finding::IllConditioned {
+                condition_number: *condition_number,
+                limit: *limit,
+            },
+            Warning::PoorlyDetermined {
+                parameter,
+                relative_std_error,
+            } => Finding::PoorlyDetermined {
+                quantity: (*parameter).to_owned(),
+                relative_std_error: *relative_std_error,
+            },
+            Warning::NotConverged {
+                iterations,
+                last_step,
+            } => Finding::NotConverged {
+                iterations: *iterations,
+                last_step: *last_step,
+            },
+            Warning::NoSignificantTransient { significance } => Finding::NoSignificantTransient {
+                significance: *significance,
+            },
+            Warning::Unphysical { parameter, value } => Finding::Unphysical {
+                quantity: (*parameter).to_owned(),
+                value: *value,
+            },
+        };
+        Self {
+            finding,
+            severity: Severity::Warning,
+            message: w.to_string(),
+        }
+    }
+}
+
+fn message(f: &Finding) -> String {
+    match f {
+        Finding::DirectionIllConditioned {
+            direction,
+            rcond,
+            rcond_min,
+        } => format!(
+            "the {} direction is ill-conditioned (rcond {rcond:.2e} < rcond_min {rcond_min:e}): \
+             its m, c, k are withheld",
+            direction.name()
+        ),
+        Finding::DirectionSingular { direction } => format!(
+            "the {} direction is singular (the least squares has no unique solution, or the \
+             noise compensation exceeds the information in the data): its m, c, k are withheld",
+            direction.name()
+        ),
+        Finding::TimeGridDrift {
+            dt_used_s,
+            dt_all_s,
+            fitted_over,
+            samples,
+        } => format!(
+            "the sampling period fitted over the first {fitted_over} time stamps, {dt_used_s:e} s, \
+             differs from that of all {samples}, {dt_all_s:e} s, by {:.1e} (relative): the \
+             estimates are biased by about twice that; identify the whole record as a file \
+             (its grid is fitted over every stamp) or give the sampling period",
+            (dt_all_s - dt_used_s).abs() / dt_used_s
+        ),
+        Finding::CrbUnavailable { reason } => {
+            format!("the Cramer-Rao bound was not computed: {reason}")
+        }
+        // The refinement's findings are made from its warnings (`From<&Warning>`), which
+        // carry their own sentences; this is only their fallback.
+        other => format!("{other:?}"),
+    }
+}

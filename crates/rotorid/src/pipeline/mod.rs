@@ -1,0 +1,284 @@
+//! The identification pipeline every caller uses (the `rotorid` command, the Python
+//! package, the fleet worker): a [`Record`], what is [`Knowledge`] besides it, and a
+//! [`Method`] give one [`Identification`] with its [`Diagnostic`]s; a [`Session`] does the
+//! same for samples that arrive as a stream. docs/method.md explains each step.
+//!
+//! ```
+//! use rotorid::pipeline::{identify, Knowledge, Method, Record};
+//! use rotorid::simulate::{add_noise, simulate, Method as Simulation};
+//! use rotorid::{Parameter, Scenario};
+//!
+//! let scenario = Scenario::table1(); // the paper's rotor at 1200 rpm, 1 s at 10 kHz
+//! let mut response = simulate(&scenario, Simulation::Exact)?;
+//! add_noise(&mut response, 40.0, 1)?; // 40 dB SNR
+//! let record = Record::from_response(&response)?;
+//! let result = identify(&record, &Knowledge::from_scenario(&scenario), &Method::refine())?;
+//! let m = result.parameter(Parameter::M).unwrap();
+//! let (value, std) = (m.value.unwrap(), m.std_error.unwrap()); // ~6e-4 kg
+//! assert!((value - 14.29).abs() < 5.0 * std);
+//! assert!(result.diagnostics.is_empty());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod diagnostic;
+mod error;
+mod grid;
+mod identification;
+mod knowledge;
+mod method;
+mod record;
+mod refine_run;
+mod session;
+mod start;
+
+pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};
+pub use error::PipelineError;
+pub use grid::{RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE, SNAP_DT, SNAP_T0};
+pub use identification::{
+    AlgebraicDetail, Covariance, CrbAt, FinalEstimate, Identification, ModulatingDetail, Noise,
+    NoiseSource, ParameterResult, RecordInfo, RefineDetail, RotorSummary, Start, StartSource,
+    StateResult, IDENTIFICATION_SCHEMA,
+};
+pub use knowledge::{Knowledge, RotorValues, Truth};
+pub use method::{
+    AlgebraicSettings, Method, MethodName, ModulatingSettings, RefineSettings, StartPolicy,
+};
+pub use record::{rebased, Record, Speed, SpeedSource, CONSTANT_PHI_TOLERANCE};
+pub use refine_run::REFINE_MIN_SAMPLES;
+pub use session::{
+    Sample, SampleEstimate, Session, Timing, ALGEBRAIC_MIN_SAMPLES, DEFAULT_GRID_HEAD,
+    GRID_DRIFT_LIMIT,
+};
+pub use start::ALGEBRAIC_START_S;
+
+use crate::identify::algebraic::{AlgebraicEstimate, ConvergenceTracker};
+use crate::identify::modulating::ModulatingEstimate;
+use crate::parameter::Parameter;
+
+use identification::finite;
+use refine_run::relative_error;
+
+/// MODULATING_STD_ERROR_BASIS: how the modulating identifier's standard errors are computed.
+pub const MODULATING_STD_ERROR_BASIS: &str =
+    "first-order sandwich covariance of the least squares, with the correlations of \
+     overlapping windows, for white noise of the estimated sigma_x, sigma_z";
+
+/// Identify `record` by `method`, knowing `knowledge` (module doc). The algebraic
+/// method's estimate at every sample is in [`Identification::estimates`].
+pub fn identify(
+    record: &Record,
+    knowledge: &Knowledge,
+    method: &Method,
+) -> Result<Identification, PipelineError> {
+    if let Method::Refine(s) = method {
+        return refine_run::run(record, knowledge, s);
+    }
+    let profile = match record.speed() {
+        Speed::Profile(p) => Some(*p),
+        Speed::Samples { .. } => None,
+    };
+    let timing = Timing::Grid {
+        grid: record.grid(),
+        tolerance: f64::INFINITY,
+    };
+    let mut session = Session::new(knowledge, method, profile, timing)?;
+    session.keep_estimates();
+    let samples = matches!(record.speed(), Speed::Samples { .. });
+    let mut ignore = |_: &SampleEstimate| {};
+    for (i, &t) in record.t().iter().enumerate() {
+        let s = Sample {
+            t: Some(t),
+            x: record.x()[i],
+            z: record.z()[i],
+            speed: samples.then(|| record.speed_at(i)),
+        };
+        session.push(&s, &mut ignore)?;
+    }
+    let mut ident = session.finish(&mut ignore)?;
+    ident.record = RecordInfo {
+        max_time_deviation_s: record.grid().max_deviation,
+        speed: record.speed_source(),
+        ..ident.record
+    };
+    Ok(ident)
+}
+
+/// The record as reported.
+pub(crate) fn record_info(rec: &Record) -> RecordInfo {
+    let g = rec.grid();
+    let t = rec.t();
+    RecordInfo {
+        samples: rec.len() as u64,
+        t_first_s: t.first().copied().unwrap_or(f64::NAN),
+        t_last_s: t.last().copied().unwrap_or(f64::NAN),
+        dt_s: g.dt,
+        t0_s: g.t0,
+        grid_fitted_over: g.fitted_over as u64,
+        max_time_deviation_s: g.max_deviation,
+        speed: rec.speed_source(),
+    }
+}
+
+/// The per-direction parameters of an estimate with `values` (m_x, cx, kx, m_z, cz, kz),
+/// kept where `ok` (x, z).
+fn per_direction(
+    k: &Knowledge,
+    values: [f64; 6],
+    ok: [bool; 2],
+    fill: impl Fn(usize, &mut ParameterResult),
+) -> Vec<ParameterResult> {
+    Parameter::PER_DIRECTION
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            let determined = ok[i / 3] && values[i].is_finite();
+            let value = determined.then_some(values[i]);
+            let truth = k.truth_of(p);
+            let mut r = ParameterResult {
+                value,
+                estimate: finite(values[i]),
+                truth,
+                relative_error: relative_error(value, truth),
+                determined,
+                ..ParameterResult::new(p)
+            };
+            fill(i, &mut r);
+            r
+        })
+        .collect()
+}
+
+/// The rotor of per-direction results, when all are determined (m: mean of m_x, m_z).
+fn rotor_of(k: &Knowledge, params: &[ParameterResult]) -> Option<RotorSummary> {
+    let v: Vec<f64> = params.iter().map(|r| r.value).collect::<Option<_>>()?;
+    Some(RotorSummary {
+        m: 0.5 * (v[0] + v[3]),
+        cx: v[1],
+        kx: v[2],
+        cz: v[4],
+        kz: v[5],
+        a: k.a,
+        mud: k.unbalance.mud(),
+        alpha: k.unbalance.alpha,
+    })
+}
+
+fn algebraic_identification(
+    record: RecordInfo,
+    k: &Knowledge,
+    s: &AlgebraicSettings,
+    tracker: &ConvergenceTracker,
+    flagged: Directions<u64>,
+    last: Option<AlgebraicEstimate>,
+) -> Identification {
+    let results = tracker.results();
+    let values = results.map(|r| r.final_value.unwrap_or(f64::NAN));
+    let ok = [
+        results[0].final_value.is_some(),
+        results[3].final_value.is_some(),
+    ];
+    let parameters = per_direction(k, values, ok, |i, r| {
+        r.t_s = results[i].final_t;
+        r.identification_time_s = results[i].identification_time;
+    });
+    Identification {
+        schema: IDENTIFICATION_SCHEMA,
+        method: MethodName::Algebraic,
+        input: None,
+        scenario: None,
+        record,
+        rotor: rotor_of(k, &parameters),
+        parameters,
+        covariance: None,
+        noise: None,
+        diagnostics: Vec::new(),
+        algebraic: Some(AlgebraicDetail {
+            quadrature: s.quadrature,
+            rcond_min: s.rcond_min,
+            tol: s.tol,
+            flagged,
+            final_time_s: Directions {
+                x: results[0].final_t,
+                z: results[3].final_t,
+            },
+            last_rcond: Directions {
+                x: last.map_or(0.0, |e| e.x.rcond),
+                z: last.map_or(0.0, |e| e.z.rcond),
+            },
+        }),
+        modulating: None,
+        refine: None,
+        estimates: Vec::new(),
+    }
+}
+
+/// The modulating identifier's figures.
+pub(crate) fn modulating_detail(e: &ModulatingEstimate, rcond_min: f64) -> ModulatingDetail {
+    ModulatingDetail {
+        window_s: e.window_s,
+        hop_s: e.hop_s,
+        windows: e.windows,
+        rcond_min,
+        rcond: Directions {
+            x: e.x.rcond,
+            z: e.z.rcond,
+        },
+        t_s: e.t,
+        compensated: e.compensated,
+        std_error_basis: MODULATING_STD_ERROR_BASIS.to_owned(),
+    }
+}
+
+fn modulating_identification(
+    record: RecordInfo,
+    k: &Knowledge,
+    s: &ModulatingSettings,
+    e: &ModulatingEstimate,
+) -> Identification {
+    let rcond_min = s.config.rcond_min;
+    let ok = e.well_conditioned(rcond_min);
+    let std = e.std_errors();
+    let values = e.values();
+    let parameters = per_direction(k, values, ok, |i, r| {
+        if ok[i / 3] {
+            r.std_error = finite(std[i]);
+            r.relative_std_error = finite(std[i] / values[i].abs());
+            r.t_s = Some(e.t);
+        }
+    });
+    let diagnostics = [(Direction::X, e.x), (Direction::Z, e.z)]
+        .iter()
+        .filter(|(_, d)| !d.well_conditioned(rcond_min))
+        .map(|&(direction, d)| {
+            Diagnostic::new(if d.rcond > 0.0 {
+                Finding::DirectionIllConditioned {
+                    direction,
+                    rcond: d.rcond,
+                    rcond_min,
+                }
+            } else {
+                Finding::DirectionSingular { direction }
+            })
+        })
+        .collect();
+    Identification {
+        schema: IDENTIFICATION_SCHEMA,
+        method: MethodName::Modulating,
+        input: None,
+        scenario: None,
+        record,
+        rotor: rotor_of(k, &parameters),
+        parameters,
+        covariance: None,
+        noise: Some(Noise {
+            sigma_x_m: e.sigma_x,
+            sigma_z_m: e.sigma_z,
+            source: NoiseSource::FourthDifferences,
+        }),
+        diagnostics,
+        algebraic: None,
+        modulating: Some(modulating_detail(e, rcond_min)),
+        refine: None,
+        estimates: Vec::new(),
+    }
+}

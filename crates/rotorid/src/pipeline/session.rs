@@ -1,0 +1,522 @@
+//! A streaming identification: samples are pushed as they arrive (one by one or in
+//! chunks) and [`Session::finish`] returns the [`Identification`]. The algebraic
+//! identifier reports an estimate per sample as soon as it can, in bounded memory; the
+//! modulating identifier updates its least squares window by window, in bounded memory;
+//! the refinement holds the samples and fits them at the end.
+//!
+//! The time grid: given ([`Timing::Grid`]), or fitted by least squares over the first
+//! `head` stamps ([`Timing::Fit`]), which are held back until then; [`Session::start_now`]
+//! fits over what has arrived (a live acquisition that has run dry). Every later stamp is
+//! checked against the least-squares fit of all stamps so far. At the end the grid of all
+//! stamps is compared with the one used ([`Finding::TimeGridDrift`]).
+
+use crate::identify::algebraic::{AlgebraicEstimate, AlgebraicIdentifier, ConvergenceTracker};
+use crate::identify::modulating::ModulatingIdentifier;
+use crate::identify::Measurement;
+use crate::model::{SpeedProfile, SpeedState};
+
+use super::diagnostic::{Diagnostic, Directions, Finding};
+use super::error::PipelineError;
+use super::grid::{check_tolerance, RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE};
+use super::identification::Identification;
+use super::knowledge::Knowledge;
+use super::method::{AlgebraicSettings, Method};
+use super::record::{Record, Speed, SpeedSource};
+
+/// Stamps over which a stream's grid is fitted by default (0.4 s at 10 kHz).
+pub const DEFAULT_GRID_HEAD: usize = 4096;
+/// Fewest samples the algebraic identifier accepts: its 3x3 system can first be well
+/// conditioned at the 4th sample (tau = 3 dt) with every quadrature rule.
+pub const ALGEBRAIC_MIN_SAMPLES: usize = 4;
+/// Relative difference between the grid of all stamps and the one used above which a
+/// stream warns ([`Finding::TimeGridDrift`]): estimates move by about twice it.
+pub const GRID_DRIFT_LIMIT: f64 = 1e-6;
+
+/// One sample as it arrives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Its time stamp \[s\]; `None` on a given grid (then t = t0 + i dt).
+    pub t: Option<f64>,
+    /// Horizontal displacement \[m\].
+    pub x: f64,
+    /// Vertical displacement \[m\].
+    pub z: f64,
+    /// phi \[rad\], w \[rad/s\], w' \[rad/s^2\]; `None` when the session's profile gives them.
+    pub speed: Option<SpeedState>,
+}
+
+/// How a session knows its time grid (module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Timing {
+    /// Least squares over the first `head` stamps (>= 2); each stamp within `tolerance`
+    /// dt of the fit.
+    Fit {
+        /// Stamps to fit over before the first estimate.
+        head: usize,
+        /// Allowed deviation from the grid, relative to dt.
+        tolerance: f64,
+    },
+    /// This grid; stamps, when given, within `tolerance` dt of it.
+    Grid {
+        /// The grid.
+        grid: TimeGrid,
+        /// Allowed deviation from the grid, relative to dt.
+        tolerance: f64,
+    },
+}
+
+impl Default for Timing {
+    fn default() -> Self {
+        Timing::Fit {
+            head: DEFAULT_GRID_HEAD,
+            tolerance: DEFAULT_TIME_TOLERANCE,
+        }
+    }
+}
+
+/// An estimate of the algebraic identifier at one sample: `estimate.t` is the sample's
+/// stamp; `well_conditioned` per direction (x, z): the values of an ill-conditioned
+/// direction must not be used.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampleEstimate {
+    /// The estimate.
+    pub estimate: AlgebraicEstimate,
+    /// Whether each direction's 3x3 system is well conditioned.
+    pub well_conditioned: [bool; 2],
+}
+
+enum Engine {
+    Algebraic {
+        id: Box<AlgebraicIdentifier>,
+        tracker: Box<ConvergenceTracker>,
+        settings: AlgebraicSettings,
+        flagged: Directions<u64>,
+        last: Option<AlgebraicEstimate>,
+        keep: Option<Vec<AlgebraicEstimate>>,
+    },
+    Modulating {
+        id: Box<ModulatingIdentifier>,
+    },
+    Refine {
+        t: Vec<f64>,
+        x: Vec<f64>,
+        z: Vec<f64>,
+        speed: [Vec<f64>; 3],
+    },
+}
+
+/// A streaming identification (module doc).
+pub struct Session {
+    knowledge: Knowledge,
+    method: Method,
+    profile: Option<SpeedProfile>,
+    timing: Timing,
+    /// The grid in use, once known.
+    grid: Option<TimeGrid>,
+    /// The least-squares fit of every stamp so far.
+    running: RunningGrid,
+    head: Vec<Sample>,
+    engine: Option<Engine>,
+    /// Samples pushed (including the held-back head).
+    pushed: usize,
+    /// Samples the engine has seen.
+    done: usize,
+    stamped: Option<bool>,
+    has_speed: Option<bool>,
+    t_first: f64,
+    t_last: f64,
+    max_deviation: f64,
+    keep: bool,
+}
+
+impl Session {
+    /// A session for `method`, with `profile` as the speed when the samples carry none.
+    pub fn new(
+        knowledge: &Knowledge,
+        method: &Method,
+        profile: Option<SpeedProfile>,
+        timing: Timing,
+    ) -> Result<Self, PipelineError> {
+        let (Timing::Fit { tolerance, .. } | Timing::Grid { tolerance, .. }) = timing;
+        check_tolerance(tolerance)?;
+        if let Timing::Fit { head, .. } = timing {
+            crate::model::check("head", head as f64, "an integer >= 2 (stamps)", |v| {
+                v >= 2.0
+            })?;
+        }
+        knowledge
+            .identify_known()
+            .validated()
+            .map_err(crate::identify::algebraic::AlgebraicError::from)?;
+        if let Method::Algebraic(s) = method {
+            s.config()?;
+        }
+        let grid = match timing {
+            Timing::Grid { grid, .. } => Some(grid),
+            Timing::Fit { .. } => None,
+        };
+        Ok(Self {
+            knowledge: *knowledge,
+            method: *method,
+            profile,
+            timing,
+            grid,
+            running: RunningGrid::default(),
+            head: Vec::new(),
+            engine: None,
+            pushed: 0,
+            done: 0,
+            stamped: None,
+            has_speed: None,
+            t_first: f64::NAN,
+            t_last: f64::NAN,
+            max_deviation: 0.0,
+            keep: false,
+        })
+    }
+
+    /// Keep every algebraic estimate for [`Identification::estimates`] (memory grows with
+    /// the record; off by default).
+    pub fn keep_estimates(&mut self) {
+        if let Some(Engine::Algebraic { keep, .. }) = &mut self.engine {
+            keep.get_or_insert_with(Vec::new);
+        }
+        self.keep = true;
+    }
+
+    /// Samples pushed so far.
+    pub fn samples(&self) -> usize {
+        self.pushed
+    }
+
+    /// The grid in use, once known.
+    pub fn grid(&self) -> Option<TimeGrid> {
+        self.grid
+    }
+
+    /// Push one sample; the algebraic identifier's new estimates go to `on_estimate`
+    /// (none while the grid's head is held back, then all of them). Errors name the
+    /// sample's index (0 for the first).
+    pub fn push(
+        &mut self,
+        s: &Sample,
+        on_estimate: &mut dyn FnMut(&SampleEstimate),
+    ) -> Result<(), PipelineError> {
+        let index = self.pushed;
+        self.validate(index, s)?;
+        self.pushed += 1;
+        if self.engine.is_some() {
+            return self.process(s, on_estimate);
+        }
+        self.head.push(*s);
+        if let Timing::Fit { head, .. } = self.timing {
+            if self.head.len() >= head {
+                self.start(on_estimate)?;
+            }
+        } else {
+            self.start(on_estimate)?;
+        }
+        Ok(())
+    }
+
+    /// Fit the grid over the samples held back so far and run the identifier over them;
+    /// a no-op once started, and before the method could give anything (2 samples, 4 for
+    /// the algebraic identifier).
+    pub fn start_now(
+        &mut self,
+        on_estimate: &mut dyn FnMut(&SampleEstimate),
+    ) -> Result<(), PipelineError> {
+        if self.engine.is_some() || self.head.len() < self.least() {
+            return Ok(());
+        }
+        self.start(on_estimate)
+    }
+
+    fn validate(&mut self, index: usize, s: &Sample) -> Result<(), PipelineError> {
+        let finite = |field: &'static str, value: f64| {
+            if value.is_finite() {
+                Ok(())
+            } else {
+                Err(PipelineError::NotFinite {
+                    index,
+                    field,
+                    value,
+                })
+            }
+        };
+        finite("x", s.x)?;
+        finite("z", s.z)?;
+        if let Some(v) = s.speed {
+            finite("phi", v.phi)?;
+            finite("phi_dot", v.omega)?;
+            finite("phi_ddot", v.omega_dot)?;
+        }
+        if *self.has_speed.get_or_insert(s.speed.is_some()) != s.speed.is_some() {
+            return Err(PipelineError::SpeedPresence { index });
+        }
+        if s.speed.is_none() && self.profile.is_none() {
+            return Err(PipelineError::NoSpeed);
+        }
+        let stamped = *self.stamped.get_or_insert(s.t.is_some());
+        if stamped != s.t.is_some() {
+            return Err(PipelineError::NotFinite {
+                index,
+                field: "t",
+                value: f64::NAN,
+            });
+        }
+        let (Timing::Fit { tolerance, .. } | Timing::Grid { tolerance, .. }) = self.timing;
+        let t = match s.t {
+            Some(t) => {
+                self.running.push(index, t)?;
+                // Check against the given grid, or the fit of every stamp so far.
+                let reference = match self.timing {
+                    Timing::Grid { grid, .. } => Some(grid),
+                    Timing::Fit { .. } => self.running.grid(),
+                };
+                if let Some(g) = reference {
+                    g.check(index, t, tolerance)?;
+                    self.max_deviation = self.max_deviation.max((t - g.time(index)).abs());
+                }
+                t
+            }
+            None => match self.grid {
+                Some(g) => g.time(index),
+                None => {
+                    return Err(PipelineError::NotFinite {
+                        index,
+                        field: "t",
+                        value: f64::NAN,
+                    })
+                }
+            },
+        };
+        if index == 0 {
+            self.t_first = t;
+        }
+        self.t_last = t;
+        Ok(())
+    }
+
+    fn start(&mut self, on_estimate: &mut dyn FnMut(&SampleEstimate)) -> Result<(), PipelineError> {
+        let grid = match self.grid {
+            Some(g) => g,
+            None => self.running.grid().ok_or(PipelineError::TooFewSamples {
+                samples: self.head.len(),
+                needed: 2,
+                method: "the time grid",
+                why: "two stamps give the sampling period",
+            })?,
+        };
+        self.grid = Some(grid);
+        let known = self.knowledge.identify_known();
+        self.engine = Some(match &self.method {
+            Method::Algebraic(s) => {
+                let config = s.config()?;
+                Engine::Algebraic {
+                    id: Box::new(AlgebraicIdentifier::new(known, grid.dt, config)?),
+                    tracker: Box::new(ConvergenceTracker::new(s.tol, s.rcond_min)?),
+                    settings: *s,
+                    flagged: Directions::default(),
+                    last: None,
+                    keep: self.keep.then(Vec::new),
+                }
+            }
+            Method::Modulating(s) => Engine::Modulating {
+                id: Box::new(ModulatingIdentifier::new(known, grid.dt, s.config)?),
+            },
+            Method::Refine(_) => Engine::Refine {
+                t: Vec::new(),
+                x: Vec::new(),
+                z: Vec::new(),
+                speed: [Vec::new(), Vec::new(), Vec::new()],
+            },
+        });
+        for s in std::mem::take(&mut self.head) {
+            self.process(&s, on_estimate)?;
+        }
+        Ok(())
+    }
+
+    fn process(
+        &mut self,
+        s: &Sample,
+        on_estimate: &mut dyn FnMut(&SampleEstimate),
+    ) -> Result<(), PipelineError> {
+        let i = self.done;
+        let grid = self.grid.expect("an engine runs on a grid");
+        let tg = grid.time(i);
+        let speed = match (s.speed, self.profile) {
+            (Some(v), _) => v,
+            (None, Some(p)) => p.at(tg),
+            (None, None) => return Err(PipelineError::NoSpeed),
+        };
+        let m = Measurement {
+            t: tg,
+            x: s.x,
+            z: s.z,
+            speed,
+        };
+        match self.engine.as_mut().expect("started") {
+            Engine::Algebraic {
+                id,
+                tracker,
+                settings,
+                flagged,
+                last,
+                keep,
+            } => {
+                let mut e = id.push(&m)?;
+                e.t = s.t.unwrap_or(tg);
+                tracker.push(&e);
+                let ok = e.well_conditioned(settings.rcond_min);
+                flagged.x += u64::from(!ok[0]);
+                flagged.z += u64::from(!ok[1]);
+                *last = Some(e);
+                if let Some(k) = keep {
+                    k.push(e);
+                }
+                on_estimate(&SampleEstimate {
+                    estimate: e,
+                    well_conditioned: ok,
+                });
+            }
+            Engine::Modulating { id } => id.push(&m)?,
+            Engine::Refine { t, x, z, speed: v } => {
+                t.push(s.t.unwrap_or(tg));
+                x.push(s.x);
+                z.push(s.z);
+                if let Some(sp) = s.speed {
+                    v[0].push(sp.phi);
+                    v[1].push(sp.omega);
+                    v[2].push(sp.omega_dot);
+                }
+            }
+        }
+        self.done += 1;
+        Ok(())
+    }
+
+    /// The identification of every sample pushed.
+    pub fn finish(
+        mut self,
+        on_estimate: &mut dyn FnMut(&SampleEstimate),
+    ) -> Result<Identification, PipelineError> {
+        if self.engine.is_none() {
+            if self.head.len() < self.least() {
+                return Err(self.too_few(self.head.len()));
+            }
+            self.start(on_estimate)?;
+        }
+        let grid = self.grid.expect("started");
+        let info = super::RecordInfo {
+            samples: self.done as u64,
+            t_first_s: self.t_first,
+            t_last_s: self.t_last,
+            dt_s: grid.dt,
+            t0_s: grid.t0,
+            grid_fitted_over: grid.fitted_over as u64,
+            max_time_deviation_s: self.max_deviation,
+            speed: if self.has_speed == Some(true) {
+                SpeedSource::Samples
+            } else {
+                SpeedSource::Profile
+            },
+        };
+        let drift = self.drift(grid);
+        let mut ident = match self.engine.take().expect("started") {
+            Engine::Algebraic {
+                tracker,
+                settings,
+                flagged,
+                last,
+                keep,
+                ..
+            } => {
+                if self.done < ALGEBRAIC_MIN_SAMPLES {
+                    return Err(self.too_few(self.done));
+                }
+                let mut ident = super::algebraic_identification(
+                    info,
+                    &self.knowledge,
+                    &settings,
+                    &tracker,
+                    flagged,
+                    last,
+                );
+                ident.estimates = keep.unwrap_or_default();
+                ident
+            }
+            Engine::Modulating { id } => {
+                let est = id.finish()?;
+                let Method::Modulating(s) = &self.method else {
+                    unreachable!("the engine follows the method")
+                };
+                super::modulating_identification(info, &self.knowledge, s, &est)
+            }
+            Engine::Refine { t, x, z, speed } => {
+                let Method::Refine(s) = &self.method else {
+                    unreachable!("the engine follows the method")
+                };
+                let sp = match (self.has_speed, self.profile) {
+                    (Some(true), _) => Speed::Samples {
+                        phi: speed[0].clone(),
+                        omega: speed[1].clone(),
+                        omega_dot: speed[2].clone(),
+                    },
+                    (_, Some(p)) => Speed::Profile(p),
+                    _ => return Err(PipelineError::NoSpeed),
+                };
+                let (Timing::Fit { tolerance, .. } | Timing::Grid { tolerance, .. }) = self.timing;
+                let rec = if self.stamped == Some(true) {
+                    Record::new(t, x, z, sp, tolerance)?
+                } else {
+                    Record::uniform(grid, x, z, sp)?
+                };
+                return super::refine_run::run(&rec, &self.knowledge, s);
+            }
+        };
+        ident.diagnostics.extend(drift);
+        Ok(ident)
+    }
+
+    /// Fewest samples before the method can give anything: 4 for the algebraic
+    /// identifier, else 2 (the sampling period).
+    fn least(&self) -> usize {
+        match self.method {
+            Method::Algebraic(_) => ALGEBRAIC_MIN_SAMPLES,
+            _ if self.grid.is_some() => 1,
+            _ => 2,
+        }
+    }
+
+    fn too_few(&self, samples: usize) -> PipelineError {
+        let (needed, why) = match self.method {
+            Method::Algebraic(_) => (
+                ALGEBRAIC_MIN_SAMPLES,
+                "the 4th sample is the first at which the 3x3 system can be well conditioned",
+            ),
+            _ => (2, "two give the sampling period"),
+        };
+        PipelineError::TooFewSamples {
+            samples,
+            needed,
+            method: self.method.name().as_str(),
+            why,
+        }
+    }
+
+    /// A warning when the grid of all stamps differs from the one used.
+    fn drift(&self, used: TimeGrid) -> Option<Diagnostic> {
+        let all = self.running.grid()?;
+        let relative = (all.dt - used.dt).abs() / used.dt;
+        (relative > GRID_DRIFT_LIMIT).then(|| {
+            Diagnostic::new(Finding::TimeGridDrift {
+                dt_used_s: used.dt,
+                dt_all_s: all.dt,
+                fitted_over: used.fitted_over,
+                samples: self.running.len(),
+            })
+        })
+    }
+}
