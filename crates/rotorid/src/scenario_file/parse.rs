@@ -1,33 +1,46 @@
-//! The TOML reader of scenario files: syntax and structure from the `toml` crate (its
-//! spans give the line of every key), then each key checked by hand so that every message
-//! names the file, the line and the key as `section.key` (see [`super`] for the format).
+//! The TOML reader of scenario files: syntax and structure from `toml_edit` (the parser
+//! under the `toml` crate), whose spans give the line of every key, whether written under
+//! a `[section]` header, as a dotted key (`rotor.m = 14.29`) or in an inline table
+//! (`rotor = { m = 14.29 }`); then each key is checked by hand so that every message names
+//! the file, the line and the key as `section.key` (see [`super`] for the format).
+//!
+//! `toml_edit` is used directly rather than through `toml`'s serde interface because serde
+//! sees no span for the implicit table of a dotted key, so `toml::Spanned` cannot read
+//! `rotor.m = 14.29`.
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
+use std::ops::Range;
 
-use anyhow::{anyhow, bail};
-use rotorid::model::ModelError;
-use rotorid::{Rotor, Sampling, SpeedProfile};
-use toml::Spanned;
+use toml_edit::{ImDocument, Item, Key, Value};
 
 use super::{
-    located, rotor_key, rotor_key_map, rotor_params, unit_of, Num, ScenarioSpec, Section,
-    INITIAL_KEYS, ROTOR_KEYS, SAMPLING_KEYS, SECTIONS, SPEED_KEYS,
+    rotor_key, rotor_params, unit_of, Num, ScenarioFileError, ScenarioSpec, Section, SpeedKind,
+    INITIAL_KEYS, ROTOR_CONTENTS, ROTOR_KEYS, ROTOR_KEY_NAMES, SAMPLING_KEYS, SECTIONS, SPEED_KEYS,
 };
-
-type RawSection = BTreeMap<Spanned<String>, Spanned<toml::Value>>;
-
-/// The shape of the speed profile named by `speed.kind`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum SpeedKind {
-    Constant,
-    Ramp,
-}
+use crate::model::ModelError;
+use crate::{Rotor, Sampling, SpeedProfile};
 
 /// Parses one scenario file's text; `origin` (the file name) prefixes every message.
 pub(super) struct Parser<'a> {
     pub(super) origin: &'a str,
     pub(super) text: &'a str,
+}
+
+/// One `key = value` of a section, as read from the document.
+struct Entry<'a> {
+    key: &'a str,
+    /// 1-based line of the key.
+    line: Option<usize>,
+    value: Raw,
+    /// The value as written, on one line (for messages).
+    written: String,
+}
+
+/// A value as the checks need it.
+enum Raw {
+    Number(f64),
+    String(String),
+    Other,
 }
 
 impl Parser<'_> {
@@ -41,55 +54,94 @@ impl Parser<'_> {
             + 1
     }
 
-    fn toml_error(&self, e: toml::de::Error) -> anyhow::Error {
-        let line = e.span().map(|s| self.line(s.start));
-        let msg = e.message().trim_end();
-        match line {
-            Some(l) => anyhow!("{}:{l}: invalid TOML: {msg}", self.origin),
-            None => anyhow!("{}: invalid TOML: {msg}", self.origin),
+    fn key_line(&self, key: Option<&Key>) -> Option<usize> {
+        key.and_then(Key::span).map(|s| self.line(s.start))
+    }
+
+    /// The entry `key = value` of a section; `None` for a sub-table (`[rotor.m]`).
+    fn entry<'a>(&self, key: &'a str, at: Option<&Key>, value: Option<&Value>) -> Entry<'a> {
+        let raw = match value {
+            Some(Value::Float(f)) => Raw::Number(*f.value()),
+            // Integers beyond 2^53 round to the nearest f64, as TOML floats do.
+            Some(Value::Integer(i)) => Raw::Number(*i.value() as f64),
+            Some(Value::String(s)) => Raw::String(s.value().clone()),
+            _ => Raw::Other,
+        };
+        Entry {
+            key,
+            line: self.key_line(at),
+            value: raw,
+            written: self.written(value.and_then(Value::span)),
         }
     }
 
-    pub(super) fn parse(&self) -> anyhow::Result<ScenarioSpec> {
-        let o = self.origin;
-        // Pass 1: the top-level keys, their lines and types.
-        let top: BTreeMap<Spanned<String>, Spanned<toml::Value>> =
-            toml::from_str(self.text).map_err(|e| self.toml_error(e))?;
-        let mut lines = BTreeMap::new();
-        for (k, v) in &top {
-            let l = self.line(k.span().start);
-            let name = k.get_ref().as_str();
-            let Some(sec) = SECTIONS.iter().find(|s| **s == name) else {
-                bail!(
-                    "{o}:{l}: unknown section or key `{name}`; allowed sections: [rotor], \
-                     [speed], [sampling], [initial]"
-                );
-            };
-            if !v.get_ref().is_table() {
-                bail!(
-                    "{o}:{l}: `{name}` must be a section [{name}], found {} {}",
-                    article(v.get_ref().type_str()),
-                    v.get_ref().type_str()
-                );
-            }
-            lines.insert(*sec, l);
+    /// The source text of `span`, on one line; `{...}` for a table that has none (the
+    /// implicit table of a dotted key).
+    fn written(&self, span: Option<Range<usize>>) -> String {
+        match span.and_then(|s| self.text.get(s)) {
+            Some(t) => t.split_whitespace().collect::<Vec<_>>().join(" "),
+            None => "{...}".to_owned(),
         }
-        // Pass 2: every section as key -> spanned value (each top-level item is a table).
-        let mut raw: BTreeMap<String, RawSection> =
-            toml::from_str(self.text).map_err(|e| self.toml_error(e))?;
-        let mut take =
-            |name: &'static str, keys: &[(&'static str, &'static str)]| match raw.remove(name) {
-                Some(r) => self
-                    .section(name, lines.get(name).copied(), keys, r)
-                    .map(Some),
-                None => Ok(None),
+    }
+
+    fn origin(&self) -> String {
+        self.origin.to_owned()
+    }
+
+    pub(super) fn parse(&self) -> Result<ScenarioSpec, ScenarioFileError> {
+        let doc = ImDocument::parse(self.text).map_err(|e| ScenarioFileError::InvalidToml {
+            origin: self.origin(),
+            line: e.span().map(|s| self.line(s.start)),
+            message: e.message().trim_end().to_owned(),
+        })?;
+        let root = doc.as_table();
+        // The top level: only the four sections, each a table in any of TOML's forms.
+        let mut raw: BTreeMap<&str, (Option<usize>, Vec<Entry<'_>>)> = BTreeMap::new();
+        for (name, item) in root.iter() {
+            let line = self.key_line(root.key(name));
+            let Some(sec) = SECTIONS.iter().find(|s| **s == name) else {
+                return Err(ScenarioFileError::UnknownSection {
+                    origin: self.origin(),
+                    line,
+                    name: name.to_owned(),
+                });
             };
+            let entries = match item {
+                Item::Table(t) => t
+                    .iter()
+                    .map(|(k, it)| self.entry(k, t.key(k), it.as_value()))
+                    .collect(),
+                Item::Value(Value::InlineTable(t)) => t
+                    .iter()
+                    .map(|(k, v)| self.entry(k, t.key(k), Some(v)))
+                    .collect(),
+                other => {
+                    return Err(ScenarioFileError::NotASection {
+                        origin: self.origin(),
+                        line,
+                        name: name.to_owned(),
+                        found: other.type_name().to_owned(),
+                    })
+                }
+            };
+            raw.insert(sec, (line, entries));
+        }
+        let mut take = |name: &'static str, keys: &[(&'static str, &'static str)]| {
+            raw.remove(name)
+                .map(|(line, entries)| self.section(name, line, keys, entries))
+                .transpose()
+        };
         let rotor = take("rotor", &ROTOR_KEYS)?.map(|(s, _)| s);
         let speed = take("speed", &SPEED_KEYS[1..])?;
         let sampling = take("sampling", &SAMPLING_KEYS)?.map(|(s, _)| s);
         let initial = take("initial", &INITIAL_KEYS)?.map(|(s, _)| s);
         let Some(rotor) = rotor else {
-            bail!("{o}: missing section [rotor] (a, m_u, d, alpha_deg and, to simulate, m, cx, cz, kx, kz)");
+            return Err(ScenarioFileError::MissingSection {
+                origin: self.origin(),
+                section: "rotor".to_owned(),
+                contents: ROTOR_CONTENTS.to_owned(),
+                needed_by: None,
+            });
         };
         self.check_rotor(&rotor)?;
         let speed = match speed {
@@ -99,14 +151,13 @@ impl Parser<'_> {
         if let Some(s) = &sampling {
             self.check_sampling(s)?;
         }
-        let initial = initial.unwrap_or_default();
         Ok(ScenarioSpec {
-            origin: o.to_owned(),
+            origin: self.origin(),
             builtin: None,
             rotor,
             speed,
             sampling,
-            initial,
+            initial: initial.unwrap_or_default(),
         })
     }
 
@@ -117,68 +168,99 @@ impl Parser<'_> {
         name: &str,
         line: Option<usize>,
         keys: &[(&'static str, &'static str)],
-        raw: RawSection,
-    ) -> anyhow::Result<(Section, Option<(SpeedKind, usize)>)> {
-        let o = self.origin;
+        entries: Vec<Entry<'_>>,
+    ) -> Result<(Section, Option<SpeedKind>), ScenarioFileError> {
         let mut sec = Section {
             line,
             keys: BTreeMap::new(),
         };
         let mut kind = None;
-        for (k, v) in raw {
-            let l = self.line(k.span().start);
-            let key = k.get_ref().as_str();
+        for Entry {
+            key,
+            line,
+            value,
+            written,
+        } in entries
+        {
             if name == "speed" && key == "kind" {
-                kind = Some((speed_kind(o, l, v.get_ref())?, l));
+                kind = Some(self.speed_kind(line, value, written)?);
                 continue;
             }
             let Some((kname, unit)) = keys.iter().find(|(kk, _)| *kk == key) else {
-                let mut allowed = String::new();
-                if name == "speed" {
-                    allowed.push_str("kind, ");
-                }
-                for (i, (kk, _)) in keys.iter().enumerate() {
-                    if i > 0 {
-                        allowed.push_str(", ");
-                    }
-                    let _ = write!(allowed, "{kk}");
-                }
-                bail!("{o}:{l}: unknown key {name}.{key}; allowed keys in [{name}]: {allowed}");
+                let names = keys.iter().map(|(k, _)| *k);
+                let allowed: Vec<&str> = if name == "speed" {
+                    std::iter::once("kind").chain(names).collect()
+                } else {
+                    names.collect()
+                };
+                return Err(ScenarioFileError::UnknownKey {
+                    origin: self.origin(),
+                    line,
+                    section: name.to_owned(),
+                    key: key.to_owned(),
+                    allowed: allowed.join(", "),
+                });
             };
-            let value = match v.get_ref() {
-                toml::Value::Float(f) => *f,
-                toml::Value::Integer(i) => *i as f64,
-                other => bail!(
-                    "{o}:{l}: {name}.{key} = {other} has the wrong type: must be a number ({unit})"
-                ),
+            let Raw::Number(value) = value else {
+                return Err(ScenarioFileError::WrongType {
+                    origin: self.origin(),
+                    line,
+                    key: format!("{name}.{key}"),
+                    value: written,
+                    expected: format!("a number ({unit})"),
+                });
             };
-            sec.keys.insert(
-                kname,
-                Num {
-                    value,
-                    line: Some(l),
-                },
-            );
+            sec.keys.insert(kname, Num { value, line });
         }
         Ok((sec, kind))
     }
 
-    fn check_rotor(&self, rotor: &Section) -> anyhow::Result<()> {
-        let o = self.origin;
+    /// `speed.kind`: the string "constant" or "ramp".
+    fn speed_kind(
+        &self,
+        line: Option<usize>,
+        v: Raw,
+        written: String,
+    ) -> Result<SpeedKind, ScenarioFileError> {
+        match v {
+            Raw::String(s) if s == "constant" => Ok(SpeedKind::Constant),
+            Raw::String(s) if s == "ramp" => Ok(SpeedKind::Ramp),
+            Raw::String(value) => Err(ScenarioFileError::UnknownSpeedKind {
+                origin: self.origin(),
+                line,
+                value,
+            }),
+            Raw::Number(_) | Raw::Other => Err(ScenarioFileError::WrongType {
+                origin: self.origin(),
+                line,
+                key: "speed.kind".to_owned(),
+                value: written,
+                expected: "the string \"constant\" or \"ramp\"".to_owned(),
+            }),
+        }
+    }
+
+    /// `key = value is out of range: must be finite (deg)` for a non-finite angle.
+    fn not_finite_deg(&self, key: &str, n: Num) -> ScenarioFileError {
+        ScenarioFileError::OutOfRange {
+            origin: self.origin(),
+            line: n.line,
+            key: key.to_owned(),
+            value: n.value,
+            allowed: "finite (deg)".to_owned(),
+        }
+    }
+
+    fn check_rotor(&self, rotor: &Section) -> Result<(), ScenarioFileError> {
         // alpha is converted from degrees: check it in the user's unit first.
         if let Some(n) = rotor.get("alpha_deg") {
             if !n.value.is_finite() {
-                bail!(
-                    "{o}:{}: rotor.alpha_deg = {} is out of range: must be finite (deg)",
-                    n.line.unwrap_or(0),
-                    n.value
-                );
+                return Err(self.not_finite_deg("rotor.alpha_deg", n));
             }
         }
         // Range-check the keys present with the model's own rules: missing keys take a
         // valid placeholder, so any error comes from a key the user wrote.
-        let placeholder = rotor_params_from_table1();
-        let mut v = placeholder;
+        let mut v = rotor_params_from_table1();
         for (i, (k, _)) in ROTOR_KEYS.iter().enumerate() {
             if let Some(n) = rotor.get(k) {
                 v[i] = n.value;
@@ -191,7 +273,7 @@ impl Parser<'_> {
                 }
                 ModelError::Inconsistent(_) => rotor.line,
             };
-            located(o, line, e, &rotor_key_map())
+            ScenarioFileError::from_model(self.origin, line, e, &ROTOR_KEY_NAMES)
         })?;
         Ok(())
     }
@@ -200,59 +282,56 @@ impl Parser<'_> {
     fn speed_profile(
         &self,
         s: &Section,
-        kind: Option<(SpeedKind, usize)>,
-    ) -> anyhow::Result<SpeedProfile> {
-        let o = self.origin;
-        let at = s.line.map_or(String::new(), |l| format!(":{l}"));
-        let Some((kind, _)) = kind else {
-            bail!("{o}{at}: missing key speed.kind: must be \"constant\" or \"ramp\"");
+        kind: Option<SpeedKind>,
+    ) -> Result<SpeedProfile, ScenarioFileError> {
+        let Some(kind) = kind else {
+            return Err(ScenarioFileError::MissingSpeedKind {
+                origin: self.origin(),
+                line: s.line,
+            });
         };
         let (needed, forbidden): (&[&str], &[&str]) = match kind {
             SpeedKind::Constant => (&["rpm"], &["rpm0", "accel"]),
             SpeedKind::Ramp => (&["rpm0", "accel"], &["rpm"]),
         };
-        let kname = match kind {
-            SpeedKind::Constant => "constant",
-            SpeedKind::Ramp => "ramp",
-        };
         for k in forbidden {
             if let Some(n) = s.get(k) {
-                bail!(
-                    "{o}:{}: speed.{k} does not apply to kind = \"{kname}\" (constant takes \
-                     rpm; ramp takes rpm0 and accel)",
-                    n.line.unwrap_or(0)
-                );
+                return Err(ScenarioFileError::SpeedKeyNotApplicable {
+                    origin: self.origin(),
+                    line: n.line,
+                    key: (*k).to_owned(),
+                    kind,
+                });
             }
         }
         for k in needed {
             if s.get(k).is_none() {
-                bail!(
-                    "{o}{at}: missing key speed.{k} ({}) for kind = \"{kname}\"",
-                    unit_of(&SPEED_KEYS, k)
-                );
+                return Err(ScenarioFileError::MissingSpeedKey {
+                    origin: self.origin(),
+                    line: s.line,
+                    key: (*k).to_owned(),
+                    unit: unit_of(&SPEED_KEYS, k).to_owned(),
+                    kind,
+                });
             }
         }
         let phi0 = s.get("phi0_deg");
         if let Some(n) = phi0 {
             if !n.value.is_finite() {
-                bail!(
-                    "{o}:{}: speed.phi0_deg = {} is out of range: must be finite (deg)",
-                    n.line.unwrap_or(0),
-                    n.value
-                );
+                return Err(self.not_finite_deg("speed.phi0_deg", n));
             }
         }
         let phi0 = phi0.map_or(0.0, |n| n.value.to_radians());
-        let v = |k: &str| s.get(k).expect("checked above");
+        let v = |k: &str| s.get(k).map_or(f64::NAN, |n| n.value);
         let names = [
             ("rpm", "speed.rpm"),
             ("rpm0", "speed.rpm0"),
             ("accel", "speed.accel"),
             ("phi0", "speed.phi0_deg"),
         ];
-        let profile = match kind {
-            SpeedKind::Constant => SpeedProfile::constant_rpm(v("rpm").value, phi0),
-            SpeedKind::Ramp => SpeedProfile::ramp(v("rpm0").value, v("accel").value, phi0),
+        match kind {
+            SpeedKind::Constant => SpeedProfile::constant_rpm(v("rpm"), phi0),
+            SpeedKind::Ramp => SpeedProfile::ramp(v("rpm0"), v("accel"), phi0),
         }
         .map_err(|e| {
             let line = match &e {
@@ -262,12 +341,11 @@ impl Parser<'_> {
                 }
                 ModelError::Inconsistent(_) => s.line,
             };
-            located(o, line, e, &names)
-        })?;
-        Ok(profile)
+            ScenarioFileError::from_model(self.origin, line, e, &names)
+        })
     }
 
-    fn check_sampling(&self, s: &Section) -> anyhow::Result<()> {
+    fn check_sampling(&self, s: &Section) -> Result<(), ScenarioFileError> {
         // Each key alone: dt and duration must be finite and > 0 (the pair is checked in
         // the views, where command-line overrides may replace either).
         for key in ["dt", "duration"] {
@@ -278,7 +356,7 @@ impl Parser<'_> {
                     (f64::MIN_POSITIVE, n.value)
                 };
                 if let Err(e @ ModelError::OutOfRange { .. }) = Sampling::new(dt, du) {
-                    return Err(located(
+                    return Err(ScenarioFileError::from_model(
                         self.origin,
                         n.line,
                         e,
@@ -305,27 +383,4 @@ fn rotor_params_from_table1() -> [f64; 9] {
         u.d,
         u.alpha.to_degrees(),
     ]
-}
-
-/// `speed.kind` at line `l`: the string "constant" or "ramp".
-fn speed_kind(o: &str, l: usize, v: &toml::Value) -> anyhow::Result<SpeedKind> {
-    match v {
-        toml::Value::String(s) if s == "constant" => Ok(SpeedKind::Constant),
-        toml::Value::String(s) if s == "ramp" => Ok(SpeedKind::Ramp),
-        toml::Value::String(s) => bail!(
-            "{o}:{l}: speed.kind = \"{s}\" is not a speed profile: must be \"constant\" or \
-             \"ramp\""
-        ),
-        other => bail!(
-            "{o}:{l}: speed.kind = {other} has the wrong type: must be the string \
-             \"constant\" or \"ramp\""
-        ),
-    }
-}
-
-fn article(type_str: &str) -> &'static str {
-    match type_str.as_bytes().first() {
-        Some(b'a' | b'e' | b'i' | b'o' | b'u') => "an",
-        _ => "a",
-    }
 }
