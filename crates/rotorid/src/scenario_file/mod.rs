@@ -153,17 +153,17 @@ pub struct ScenarioSpec {
 /// Command-line values that take precedence over the scenario file in `simulate`.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SimulationOverrides {
-    /// `--dt` [s].
+    /// `--dt` \[s\].
     pub dt: Option<f64>,
-    /// `--duration` [s].
+    /// `--duration` \[s\].
     pub duration: Option<f64>,
-    /// `--initial-x` [m].
+    /// `--initial-x` \[m\].
     pub x: Option<f64>,
-    /// `--initial-z` [m].
+    /// `--initial-z` \[m\].
     pub z: Option<f64>,
-    /// `--initial-vx` [m/s].
+    /// `--initial-vx` \[m/s\].
     pub vx: Option<f64>,
-    /// `--initial-vz` [m/s].
+    /// `--initial-vz` \[m/s\].
     pub vz: Option<f64>,
 }
 
@@ -171,15 +171,15 @@ pub struct SimulationOverrides {
 /// the identification error only; the identifier never sees them).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Truth {
-    /// m [kg] (common to both directions).
+    /// m \[kg\] (common to both directions).
     pub m: Option<f64>,
-    /// cx [N s/m].
+    /// cx \[N s/m\].
     pub cx: Option<f64>,
-    /// cz [N s/m].
+    /// cz \[N s/m\].
     pub cz: Option<f64>,
-    /// kx [N/m].
+    /// kx \[N/m\].
     pub kx: Option<f64>,
-    /// kz [N/m].
+    /// kz \[N/m\].
     pub kz: Option<f64>,
 }
 
@@ -207,13 +207,13 @@ impl Truth {
 /// truth, and the optional speed profile and sampling grid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IdentificationScenario {
-    /// Gyroscopic coefficient a [N s^2/m].
+    /// Gyroscopic coefficient a \[N s^2/m\].
     pub a: f64,
-    /// Unbalance mass m_u [kg].
+    /// Unbalance mass m_u \[kg\].
     pub m_u: f64,
-    /// Unbalance radius d [m].
+    /// Unbalance radius d \[m\].
     pub d: f64,
-    /// Unbalance angular position alpha [rad].
+    /// Unbalance angular position alpha \[rad\].
     pub alpha: f64,
     /// True m, c, k when the scenario states them.
     pub truth: Truth,
