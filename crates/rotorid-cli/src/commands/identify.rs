@@ -30,6 +30,7 @@ mod start;
 use anyhow::Context as _;
 use rotorid::identify::Quadrature;
 
+use crate::io::LoadScenario as _;
 use crate::io::{
     is_broken_pipe, open_input, EstimateRow, EstimatesWriter, FileMode, FlushBeforeRead, Output,
     ParameterSet, ScenarioSpec, SharedWriter, Summary, Truth, SUMMARY_FORMAT_VERSION,

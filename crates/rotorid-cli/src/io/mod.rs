@@ -28,5 +28,7 @@ pub use estimates_csv::{EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES
 pub use output::{is_broken_pipe, open_input, FileMode, FlushBeforeRead, Output, SharedWriter};
 pub use params::ParameterSet;
 pub use response_csv::{ResponseReader, ResponseRow, ResponseWriter, DEFAULT_TIME_TOLERANCE};
-pub use scenario::{IdentificationScenario, ScenarioSpec, SimulationOverrides, Truth};
+pub use scenario::{
+    IdentificationScenario, LoadScenario, ScenarioSpec, SimulationOverrides, Truth,
+};
 pub use summary::{Directions, Summary, SUMMARY_FORMAT_VERSION};
