@@ -9,14 +9,19 @@
 //! - [`refine`]: output-error (maximum-likelihood) refinement with uncertainties.
 //! - [`pipeline`]: record -> identification with diagnostics, the entry point of every
 //!   caller (batch [`pipeline::identify`] and streaming [`pipeline::Session`]).
+//! - `scenario_file` (feature `toml`): scenario files (rotor, speed, sampling, initial
+//!   state) parsed from TOML text, with errors naming file, line, key and allowed range.
 //!
-//! Pure computation: no file I/O, no plotting (those live in the `rotorid` command).
+//! Pure computation: no file I/O (callers read files and hand over their text), no
+//! plotting (those live in the `rotorid` command).
 
 pub mod identify;
 pub mod model;
 pub mod parameter;
 pub mod pipeline;
 pub mod refine;
+#[cfg(feature = "toml")]
+pub mod scenario_file;
 pub mod simulate;
 
 pub use model::{

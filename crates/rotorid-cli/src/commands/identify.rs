@@ -12,6 +12,7 @@ use rotorid::identify::modulating::ModulatingConfig;
 use rotorid::pipeline::{AlgebraicSettings, Method, ModulatingSettings, RefineSettings};
 use rotorid::refine::Unknowns;
 
+use crate::io::LoadScenario as _;
 use crate::io::{is_broken_pipe, open_input, FileMode, Output, ScenarioSpec};
 
 // The defaults shown in `--help`, each written once (a test keeps them equal to the

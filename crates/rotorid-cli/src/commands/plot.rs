@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 
 use crate::io::columns::{csv_reader, normalise, read_error};
+use crate::io::LoadScenario as _;
 use crate::io::{
     open_input, EstimateRow, EstimatesReader, ResponseReader, ScenarioSpec, Truth, ESTIMATES_HEADER,
 };

@@ -18,6 +18,7 @@ use anyhow::Context as _;
 use rotorid::simulate::{add_noise, integrator, Method, TimeResponse};
 
 use crate::io::progress::{progress_bar, PROGRESS_STRIDE};
+use crate::io::LoadScenario as _;
 use crate::io::{
     is_broken_pipe, FileMode, Output, ResponseWriter, ScenarioSpec, SimulationOverrides,
 };

@@ -27,4 +27,4 @@ pub use estimates_csv::{EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES
 pub use output::{is_broken_pipe, open_input, FileMode, Output};
 pub use params::ParameterSet;
 pub use response_csv::{ResponseReader, ResponseWriter};
-pub use scenario::{ScenarioSpec, SimulationOverrides, Truth};
+pub use scenario::{LoadScenario, ScenarioSpec, SimulationOverrides, Truth};

@@ -218,3 +218,80 @@ fn identify_accepts_a_scenario_with_only_the_known_quantities() {
     let e = String::from_utf8(out.stderr).unwrap();
     assert!(e.contains("missing key rotor.m (kg)"), "{e}");
 }
+
+/// `simulate --scenario PATH` refused because PATH is over the 1 MiB cap: the message
+/// names the file and the cap, and the run ends within seconds whatever PATH holds.
+fn refused_as_too_large(path: &str) {
+    let out = rotorid()
+        .args(["simulate", "--scenario", path, "--out", "-"])
+        .timeout(std::time::Duration::from_secs(30))
+        .output()
+        .unwrap();
+    let e = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains(&format!(
+            "cannot read scenario file {path}: larger than 1 MiB, the limit for scenario files"
+        )),
+        "{e}"
+    );
+}
+
+#[test]
+fn scenario_files_over_one_mib_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("big.toml");
+    // Valid TOML (one long comment) of 2 MiB: refused for its size, not its content.
+    let mut text = vec![b'#'; 2 << 20];
+    text.push(b'\n');
+    std::fs::write(&path, text).unwrap();
+    refused_as_too_large(path.to_str().unwrap());
+    // An endless device is read only up to the cap.
+    refused_as_too_large("/dev/zero");
+}
+
+#[test]
+fn an_endless_pipe_is_refused_after_one_mib() {
+    use std::io::Write as _;
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rotorid"))
+        .args(["simulate", "--scenario", "/dev/stdin", "--out", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    // Writes comment lines until rotorid closes the pipe (then the write fails).
+    let writer = std::thread::spawn(move || {
+        let line = [b"#".repeat(1023), b"\n".to_vec()].concat();
+        let mut written = 0usize;
+        while stdin.write_all(&line).is_ok() {
+            written += line.len();
+        }
+        written
+    });
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if Instant::now() > deadline {
+            child.kill().unwrap();
+            panic!("rotorid kept reading an endless scenario pipe");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let written = writer.join().unwrap();
+    let mut e = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut e).unwrap();
+    assert_eq!(status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("cannot read scenario file /dev/stdin: larger than 1 MiB"),
+        "{e}"
+    );
+    // The pipe holds at most a few buffers beyond what rotorid read.
+    assert!(written < 4 << 20, "{written} bytes written");
+}

@@ -14,7 +14,7 @@ use std::rc::Rc;
 
 use anyhow::Context as _;
 use rotorid::pipeline::{
-    Identification, Knowledge, Method, PipelineError, Sample, SampleEstimate, Session, Timing,
+    Identification, Method, PipelineError, Sample, SampleEstimate, Session, Timing,
     DEFAULT_GRID_HEAD,
 };
 use rotorid::SpeedProfile;
@@ -130,7 +130,8 @@ pub(crate) fn identify(
     method: &Method,
     time_tolerance: f64,
 ) -> anyhow::Result<Identification> {
-    let (knowledge, profile) = knowledge(spec)?;
+    let knowledge = spec.knowledge()?;
+    let profile = spec.identification()?.speed;
     let timing = Timing::Fit {
         head: DEFAULT_GRID_HEAD,
         tolerance: time_tolerance,
@@ -276,36 +277,4 @@ fn row_of(e: &SampleEstimate) -> EstimateRow {
         rcond_x: est.x.rcond,
         rcond_z: est.z.rcond,
     }
-}
-
-/// What the scenario tells the pipeline: the known a and unbalance, its m, c, k as
-/// nominal values and truth (with its initial state when it describes a whole
-/// simulation), and its speed profile.
-fn knowledge(spec: &ScenarioSpec) -> anyhow::Result<(Knowledge, Option<SpeedProfile>)> {
-    let v = spec.identification()?;
-    let t = &v.truth;
-    let values = rotorid::pipeline::RotorValues {
-        m: t.m,
-        cx: t.cx,
-        kx: t.kx,
-        cz: t.cz,
-        kz: t.kz,
-    };
-    let ov = crate::io::SimulationOverrides {
-        dt: Some(1.0),
-        duration: Some(1.0),
-        ..Default::default()
-    };
-    let initial = spec.simulation(&ov).ok().map(|s| s.initial);
-    let k = Knowledge {
-        a: v.a,
-        unbalance: rotorid::Unbalance {
-            m_u: v.m_u,
-            d: v.d,
-            alpha: v.alpha,
-        },
-        nominal: values,
-        truth: (!t.is_empty()).then_some(rotorid::pipeline::Truth { values, initial }),
-    };
-    Ok((k, v.speed))
 }

@@ -1,59 +1,72 @@
-//! Scenario files: the rotor of the paper's eq. (1), its speed profile, the sampling grid
-//! and the initial state, written in TOML with SI units (method.md section 1).
+//! Scenario files: the rotor of the paper's eq. (1) ([`crate::model`]), its speed profile,
+//! the sampling grid and the initial state, written in TOML with SI units. Behind the
+//! `toml` feature; this module parses text only (reading the file is the caller's).
 //!
 //! ```toml
 //! [rotor]
-//! m = 14.29        # kg          modal mass (common to x and z)
-//! cx = 10.0        # N s/m       support damping (cz likewise)
-//! kx = 1.195e6     # N/m         support stiffness (kz likewise)
+//! m = 14.29        # kg          modal mass of the disk (common to x and z), > 0
+//! cx = 10.0        # N s/m       support damping in x, >= 0 (cz likewise)
+//! cz = 10.0
+//! kx = 1.195e6     # N/m         support stiffness in x, > 0 (kz likewise)
+//! kz = 1.195e6
 //! a = 2.871        # N s^2/m     gyroscopic coefficient
-//! m_u = 1.0e-4     # kg          unbalance mass
-//! d = 0.15         # m           unbalance radius
+//! m_u = 1.0e-4     # kg          unbalance mass, >= 0
+//! d = 0.15         # m           unbalance radius, >= 0
 //! alpha_deg = 45.0 # deg         unbalance angular position
+//!
 //! [speed]
-//! kind = "constant"  # rpm = 1200.0  (w = rpm 2 pi / 60 rad/s)
-//! # kind = "ramp":   rpm0 = 0.0, accel = 10.0 (rad/s^2): w(t) = w0 + accel t
-//! # optional for both: phi0_deg = 0.0, the rotor angle phi(0)
+//! kind = "constant"  # rpm = 1200.0 (rev/min): w = rpm 2 pi / 60 rad/s
+//! rpm = 1200.0
+//! # kind = "ramp":   rpm0 = 0.0 (rev/min), accel = 10.0 (rad/s^2): w(t) = w0 + accel t
+//! # optional for both: phi0_deg = 0.0 (deg), the rotor angle phi(0)
+//!
 //! [sampling]
 //! dt = 1.0e-4      # s
 //! duration = 1.0   # s          samples t_i = i dt, i = 0 ..= floor(duration / dt)
+//!
 //! [initial]        # optional, every key defaults to 0
 //! x = 0.0          # m          (z likewise)
 //! vx = 0.0         # m/s        (vz likewise)
 //! ```
 //!
-//! Integers are accepted wherever a number is expected (`kx = 1195000`); TOML's `nan` and
-//! `inf` are read and then rejected by the range checks.
+//! Any form of TOML that names the same keys is the same file: dotted keys
+//! (`rotor.m = 14.29`, `speed.kind = "constant"` at the top), inline tables
+//! (`sampling = { dt = 1.0e-4, duration = 1.0 }`) and sections may be mixed, one form per
+//! section. Integers are accepted wherever a number is expected (`kx = 1195000`); TOML's
+//! `nan` and `inf` are read and then rejected by the range checks.
 //!
-//! The file is parsed once into a [`ScenarioSpec`], which checks every key that is present
+//! The text is parsed once into a [`ScenarioSpec`], which checks every key that is present
 //! (unknown keys, wrong types, out-of-range values) and offers two views:
 //!
 //! - [`ScenarioSpec::simulation`]: everything is required (rotor, speed, sampling); the
-//!   command line may override `sampling.dt`, `sampling.duration` and `[initial]`.
+//!   caller may override `sampling.dt`, `sampling.duration` and `[initial]`
+//!   ([`SimulationOverrides`], named by their command-line flags in messages).
 //! - [`ScenarioSpec::identification`]: only what the identifier must know (`a`, `m_u`, `d`,
 //!   `alpha_deg`); `m`, `cx`, `cz`, `kx`, `kz` are optional and used only as the truth to
 //!   report errors against; `[speed]` is optional (needed only when the response has no
 //!   phi columns) and `[sampling]` is optional.
 //!
-//! Every error names the file, the line (as editors count, from TOML's spans), the key as
-//! `section.key`, the value and the allowed range with its unit; range messages are the
-//! model's own ([`rotorid::model::ModelError`]), with the model's field name mapped to the
-//! TOML key.
+//! Every error ([`ScenarioFileError`]) names the file, the line (as editors count, from the
+//! TOML parser's spans, for dotted keys and inline-table entries too), the key as
+//! `section.key`, the value and the allowed range with its unit, e.g.
+//! `rig.toml:7: rotor.kx = -1195000 is out of range: must be finite and > 0 (N/m)`. Range
+//! rules and their words are the model's own ([`ModelError`]), with the model's field name
+//! mapped to the TOML key.
 //!
 //! The TOML reader is in `parse.rs`; this file holds the parsed form and its views.
-//!
-//! `table1` names the built-in scenario [`Scenario::table1`] (paper's Table 1, 1200 rpm,
-//! dt = 0.1 ms, 1 s, at rest); any other argument is a path (write `./table1` for a file
-//! called `table1`).
+//! [`BUILTIN_TABLE1`] is the name callers give the built-in [`Scenario::table1`] (paper's
+//! Table 1, 1200 rpm, dt = 0.1 ms, 1 s, at rest): see [`ScenarioSpec::builtin`].
 
+mod error;
 mod parse;
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::fmt;
 
-use anyhow::{anyhow, bail, Context as _};
-use rotorid::model::ModelError;
-use rotorid::{InitialState, Rotor, RotorParams, Sampling, Scenario, SpeedProfile, Unbalance};
+pub use error::ScenarioFileError;
+
+use crate::model::ModelError;
+use crate::{InitialState, Rotor, RotorParams, Sampling, Scenario, SpeedProfile, Unbalance};
 
 /// The name of the built-in scenario, the paper's Table 1 ([`Scenario::table1`]).
 pub const BUILTIN_TABLE1: &str = "table1";
@@ -80,6 +93,27 @@ const SPEED_KEYS: [(&str, &str); 5] = [
 const SAMPLING_KEYS: [(&str, &str); 2] = [("dt", "s"), ("duration", "s")];
 const INITIAL_KEYS: [(&str, &str); 4] = [("x", "m"), ("z", "m"), ("vx", "m/s"), ("vz", "m/s")];
 const SECTIONS: [&str; 4] = ["rotor", "speed", "sampling", "initial"];
+/// What `[rotor]` and `[speed]` hold, for the messages about a missing section.
+const ROTOR_CONTENTS: &str = "a, m_u, d, alpha_deg and, to simulate, m, cx, cz, kx, kz";
+const SPEED_CONTENTS: &str = "kind = \"constant\" with rpm, or kind = \"ramp\" with rpm0 and accel";
+
+/// The shape of the speed profile named by `speed.kind`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpeedKind {
+    /// `kind = "constant"`: `rpm`.
+    Constant,
+    /// `kind = "ramp"`: `rpm0` and `accel`.
+    Ramp,
+}
+
+impl fmt::Display for SpeedKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Constant => "constant",
+            Self::Ramp => "ramp",
+        })
+    }
+}
 
 /// A number read from the scenario file (or given on the command line), with its origin.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -119,17 +153,17 @@ pub struct ScenarioSpec {
 /// Command-line values that take precedence over the scenario file in `simulate`.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SimulationOverrides {
-    /// `--dt` [s].
+    /// `--dt` \[s\].
     pub dt: Option<f64>,
-    /// `--duration` [s].
+    /// `--duration` \[s\].
     pub duration: Option<f64>,
-    /// `--initial-x` [m].
+    /// `--initial-x` \[m\].
     pub x: Option<f64>,
-    /// `--initial-z` [m].
+    /// `--initial-z` \[m\].
     pub z: Option<f64>,
-    /// `--initial-vx` [m/s].
+    /// `--initial-vx` \[m/s\].
     pub vx: Option<f64>,
-    /// `--initial-vz` [m/s].
+    /// `--initial-vz` \[m/s\].
     pub vz: Option<f64>,
 }
 
@@ -137,15 +171,15 @@ pub struct SimulationOverrides {
 /// the identification error only; the identifier never sees them).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Truth {
-    /// m [kg] (common to both directions).
+    /// m \[kg\] (common to both directions).
     pub m: Option<f64>,
-    /// cx [N s/m].
+    /// cx \[N s/m\].
     pub cx: Option<f64>,
-    /// cz [N s/m].
+    /// cz \[N s/m\].
     pub cz: Option<f64>,
-    /// kx [N/m].
+    /// kx \[N/m\].
     pub kx: Option<f64>,
-    /// kz [N/m].
+    /// kz \[N/m\].
     pub kz: Option<f64>,
 }
 
@@ -173,13 +207,13 @@ impl Truth {
 /// truth, and the optional speed profile and sampling grid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IdentificationScenario {
-    /// Gyroscopic coefficient a [N s^2/m].
+    /// Gyroscopic coefficient a \[N s^2/m\].
     pub a: f64,
-    /// Unbalance mass m_u [kg].
+    /// Unbalance mass m_u \[kg\].
     pub m_u: f64,
-    /// Unbalance radius d [m].
+    /// Unbalance radius d \[m\].
     pub d: f64,
-    /// Unbalance angular position alpha [rad].
+    /// Unbalance angular position alpha \[rad\].
     pub alpha: f64,
     /// True m, c, k when the scenario states them.
     pub truth: Truth,
@@ -193,8 +227,8 @@ pub struct IdentificationScenario {
 
 impl IdentificationScenario {
     /// The quantities the algebraic identifier takes as known: a, m_u d, alpha.
-    pub fn known(&self) -> rotorid::identify::Known {
-        rotorid::identify::Known {
+    pub fn known(&self) -> crate::identify::Known {
+        crate::identify::Known {
             a: self.a,
             mud: self.m_u * self.d,
             alpha: self.alpha,
@@ -203,18 +237,8 @@ impl IdentificationScenario {
 }
 
 impl ScenarioSpec {
-    /// `table1` (the built-in [`Scenario::table1`]) or the path of a TOML scenario file.
-    pub fn load(arg: &str) -> anyhow::Result<Self> {
-        if arg == BUILTIN_TABLE1 {
-            return Ok(Self::builtin(BUILTIN_TABLE1, Scenario::table1()));
-        }
-        let path = Path::new(arg);
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read scenario file {}", path.display()))?;
-        Self::parse(&path.display().to_string(), &text)
-    }
-
-    /// A spec holding an already validated scenario (`origin` names it in messages).
+    /// A spec holding an already validated scenario (`origin` names it in messages), e.g.
+    /// `ScenarioSpec::builtin(BUILTIN_TABLE1, Scenario::table1())`.
     pub fn builtin(origin: &str, scenario: Scenario) -> Self {
         Self {
             origin: origin.to_owned(),
@@ -227,7 +251,7 @@ impl ScenarioSpec {
     }
 
     /// Parse and check the TOML `text`; `origin` (the file name) prefixes every message.
-    pub fn parse(origin: &str, text: &str) -> anyhow::Result<Self> {
+    pub fn parse(origin: &str, text: &str) -> Result<Self, ScenarioFileError> {
         parse::Parser { origin, text }.parse()
     }
 
@@ -236,8 +260,9 @@ impl ScenarioSpec {
         &self.origin
     }
 
-    /// The complete scenario `simulate` needs; `ov` (command-line values) take precedence.
-    pub fn simulation(&self, ov: &SimulationOverrides) -> anyhow::Result<Scenario> {
+    /// The complete scenario a simulation needs; `ov` (command-line values) take
+    /// precedence.
+    pub fn simulation(&self, ov: &SimulationOverrides) -> Result<Scenario, ScenarioFileError> {
         let o = &self.origin;
         let mut sc = match &self.builtin {
             Some(s) => *s,
@@ -245,10 +270,14 @@ impl ScenarioSpec {
                 let rotor = self.rotor_for_simulation()?;
                 let speed = match self.speed {
                     Some(p) => p,
-                    None => bail!(
-                        "{o}: missing section [speed] (kind = \"constant\" with rpm, or \
-                         kind = \"ramp\" with rpm0 and accel); simulate needs it"
-                    ),
+                    None => {
+                        return Err(ScenarioFileError::MissingSection {
+                            origin: o.clone(),
+                            section: "speed".to_owned(),
+                            contents: SPEED_CONTENTS.to_owned(),
+                            needed_by: Some("simulate".to_owned()),
+                        })
+                    }
                 };
                 let sampling = self.sampling_with(ov)?;
                 let initial = self.initial_with(ov)?;
@@ -263,8 +292,14 @@ impl ScenarioSpec {
         if ov.dt.is_some() || ov.duration.is_some() {
             let dt = ov.dt.unwrap_or(sc.sampling.dt());
             let duration = ov.duration.unwrap_or(sc.sampling.duration());
-            sc.sampling = Sampling::new(dt, duration)
-                .map_err(|e| located(o, None, e, &[("dt", "--dt"), ("duration", "--duration")]))?;
+            sc.sampling = Sampling::new(dt, duration).map_err(|e| {
+                ScenarioFileError::from_model(
+                    o,
+                    None,
+                    e,
+                    &[("dt", "--dt"), ("duration", "--duration")],
+                )
+            })?;
         }
         let mut init = sc.initial;
         init.x = ov.x.unwrap_or(init.x);
@@ -273,12 +308,45 @@ impl ScenarioSpec {
         init.vz = ov.vz.unwrap_or(init.vz);
         sc.initial = init
             .validated()
-            .map_err(|e| located(o, None, e, INITIAL_FLAGS))?;
+            .map_err(|e| ScenarioFileError::from_model(o, None, e, INITIAL_FLAGS))?;
         Ok(sc)
     }
 
+    /// What the identification pipeline knows from this scenario: the known a and
+    /// unbalance, its m, c, k (those stated) as nominal values and as the truth, and, when
+    /// the scenario describes a whole simulation, its initial state as the true state at
+    /// t = 0. The speed profile is in [`Self::identification`].
+    pub fn knowledge(&self) -> Result<crate::pipeline::Knowledge, ScenarioFileError> {
+        let v = self.identification()?;
+        let t = &v.truth;
+        let values = crate::pipeline::RotorValues {
+            m: t.m,
+            cx: t.cx,
+            kx: t.kx,
+            cz: t.cz,
+            kz: t.kz,
+        };
+        // any grid will do: only the initial state is wanted
+        let grid = SimulationOverrides {
+            dt: Some(1.0),
+            duration: Some(1.0),
+            ..SimulationOverrides::default()
+        };
+        let initial = self.simulation(&grid).ok().map(|s| s.initial);
+        Ok(crate::pipeline::Knowledge {
+            a: v.a,
+            unbalance: Unbalance {
+                m_u: v.m_u,
+                d: v.d,
+                alpha: v.alpha,
+            },
+            nominal: values,
+            truth: (!t.is_empty()).then_some(crate::pipeline::Truth { values, initial }),
+        })
+    }
+
     /// What `identify` needs: known a, m_u, d, alpha; optional truth, speed, sampling.
-    pub fn identification(&self) -> anyhow::Result<IdentificationScenario> {
+    pub fn identification(&self) -> Result<IdentificationScenario, ScenarioFileError> {
         if let Some(s) = &self.builtin {
             let u = s.rotor.unbalance();
             return Ok(IdentificationScenario {
@@ -318,24 +386,20 @@ impl ScenarioSpec {
         })
     }
 
-    fn require_rotor(&self, key: &'static str, who: &str) -> anyhow::Result<f64> {
+    fn require_rotor(&self, key: &'static str, who: &str) -> Result<f64, ScenarioFileError> {
         match self.rotor.get(key) {
             Some(n) => Ok(n.value),
-            None => {
-                let unit = unit_of(&ROTOR_KEYS, key);
-                let at = match self.rotor.line {
-                    Some(l) => format!(" (section [rotor] at line {l})"),
-                    None => " (no [rotor] section)".to_owned(),
-                };
-                bail!(
-                    "{}: missing key rotor.{key} ({unit}){at}; {who} needs it",
-                    self.origin
-                )
-            }
+            None => Err(ScenarioFileError::MissingRotorKey {
+                origin: self.origin.clone(),
+                key: key.to_owned(),
+                unit: unit_of(&ROTOR_KEYS, key).to_owned(),
+                section_line: self.rotor.line,
+                needed_by: Some(who.to_owned()),
+            }),
         }
     }
 
-    fn rotor_for_simulation(&self) -> anyhow::Result<Rotor> {
+    fn rotor_for_simulation(&self) -> Result<Rotor, ScenarioFileError> {
         let mut v = [0.0; 9];
         for (i, (k, _)) in ROTOR_KEYS.iter().enumerate() {
             v[i] = self.require_rotor(k, "simulate")?;
@@ -344,7 +408,7 @@ impl ScenarioSpec {
         Rotor::new(rotor_params(&v)).map_err(|e| self.rotor_error(e))
     }
 
-    fn rotor_error(&self, e: ModelError) -> anyhow::Error {
+    fn rotor_error(&self, e: ModelError) -> ScenarioFileError {
         let line = match &e {
             ModelError::OutOfRange { field, .. } => {
                 let key = rotor_key(field);
@@ -352,20 +416,20 @@ impl ScenarioSpec {
             }
             ModelError::Inconsistent(_) => self.rotor.line,
         };
-        located(&self.origin, line, e, &rotor_key_map())
+        ScenarioFileError::from_model(&self.origin, line, e, &ROTOR_KEY_NAMES)
     }
 
-    fn sampling_with(&self, ov: &SimulationOverrides) -> anyhow::Result<Sampling> {
+    fn sampling_with(&self, ov: &SimulationOverrides) -> Result<Sampling, ScenarioFileError> {
         let o = &self.origin;
         let sec = self.sampling.clone().unwrap_or_default();
-        let pick = |key: &'static str, flag: &'static str, v: Option<f64>| -> anyhow::Result<Num> {
-            match (v, sec.get(key)) {
-                (Some(value), _) => Ok(Num { value, line: None }),
-                (None, Some(n)) => Ok(n),
-                (None, None) => Err(anyhow!(
-                    "{o}: missing key sampling.{key} (s); give it in [sampling] or with {flag}"
-                )),
-            }
+        let pick = |key: &str, flag: &str, v: Option<f64>| match (v, sec.get(key)) {
+            (Some(value), _) => Ok(Num { value, line: None }),
+            (None, Some(n)) => Ok(n),
+            (None, None) => Err(ScenarioFileError::MissingSamplingKey {
+                origin: o.clone(),
+                key: key.to_owned(),
+                flag: flag.to_owned(),
+            }),
         };
         let dt = pick("dt", "--dt", ov.dt)?;
         let duration = pick("duration", "--duration", ov.duration)?;
@@ -385,11 +449,11 @@ impl ScenarioSpec {
             } else {
                 "sampling.duration"
             };
-            located(o, line, e, &[("dt", dt_key), ("duration", du_key)])
+            ScenarioFileError::from_model(o, line, e, &[("dt", dt_key), ("duration", du_key)])
         })
     }
 
-    fn initial_with(&self, ov: &SimulationOverrides) -> anyhow::Result<InitialState> {
+    fn initial_with(&self, ov: &SimulationOverrides) -> Result<InitialState, ScenarioFileError> {
         let get = |k: &str, v: Option<f64>| v.or(self.initial.get(k).map(|n| n.value));
         let s = InitialState {
             x: get("x", ov.x).unwrap_or(0.0),
@@ -398,7 +462,7 @@ impl ScenarioSpec {
             vz: get("vz", ov.vz).unwrap_or(0.0),
         };
         s.validated()
-            .map_err(|e| located(&self.origin, None, e, INITIAL_FLAGS))
+            .map_err(|e| ScenarioFileError::from_model(&self.origin, None, e, INITIAL_FLAGS))
     }
 }
 
@@ -420,19 +484,18 @@ fn rotor_key(model_field: &str) -> &'static str {
     }
 }
 
-fn rotor_key_map() -> Vec<(&'static str, &'static str)> {
-    vec![
-        ("m", "rotor.m"),
-        ("cx", "rotor.cx"),
-        ("cz", "rotor.cz"),
-        ("kx", "rotor.kx"),
-        ("kz", "rotor.kz"),
-        ("a", "rotor.a"),
-        ("m_u", "rotor.m_u"),
-        ("d", "rotor.d"),
-        ("alpha", "rotor.alpha_deg"),
-    ]
-}
+/// The model's rotor field names and the TOML keys they are written as.
+const ROTOR_KEY_NAMES: [(&str, &str); 9] = [
+    ("m", "rotor.m"),
+    ("cx", "rotor.cx"),
+    ("cz", "rotor.cz"),
+    ("kx", "rotor.kx"),
+    ("kz", "rotor.kz"),
+    ("a", "rotor.a"),
+    ("m_u", "rotor.m_u"),
+    ("d", "rotor.d"),
+    ("alpha", "rotor.alpha_deg"),
+];
 
 /// RotorParams from the nine values in `ROTOR_KEYS` order (alpha in degrees).
 fn rotor_params(v: &[f64; 9]) -> RotorParams {
@@ -453,34 +516,6 @@ fn rotor_params(v: &[f64; 9]) -> RotorParams {
 
 fn unit_of(keys: &[(&'static str, &'static str)], key: &str) -> &'static str {
     keys.iter().find(|(k, _)| *k == key).map_or("", |(_, u)| *u)
-}
-
-/// Turn a model error into `origin:line: key = value is out of range: must be ...`,
-/// renaming the model's field (`kx`) to the user's key (`rotor.kx`) with `names`.
-fn located(
-    origin: &str,
-    line: Option<usize>,
-    e: ModelError,
-    names: &[(&str, &str)],
-) -> anyhow::Error {
-    let prefix = match line {
-        Some(l) => format!("{origin}:{l}"),
-        None => origin.to_owned(),
-    };
-    match e {
-        ModelError::OutOfRange {
-            field,
-            value,
-            allowed,
-        } => {
-            let key = names
-                .iter()
-                .find(|(f, _)| *f == field)
-                .map_or(field, |(_, k)| *k);
-            anyhow!("{prefix}: {key} = {value} is out of range: must be {allowed}")
-        }
-        ModelError::Inconsistent(msg) => anyhow!("{prefix}: {msg}"),
-    }
 }
 
 #[cfg(test)]
@@ -506,10 +541,14 @@ dt = 1.0e-4
 duration = 1.0
 "#;
 
+    fn table1() -> ScenarioSpec {
+        ScenarioSpec::builtin(BUILTIN_TABLE1, Scenario::table1())
+    }
+
     fn err(text: &str) -> String {
         let e = ScenarioSpec::parse("s.toml", text)
             .and_then(|s| s.simulation(&SimulationOverrides::default()).map(|_| s));
-        format!("{:#}", e.expect_err("must be rejected"))
+        format!("{}", e.expect_err("must be rejected"))
     }
 
     #[test]
@@ -517,7 +556,7 @@ duration = 1.0
         let s = ScenarioSpec::parse("s.toml", TABLE1).unwrap();
         let sc = s.simulation(&SimulationOverrides::default()).unwrap();
         assert_eq!(sc, Scenario::table1());
-        let b = ScenarioSpec::load("table1").unwrap();
+        let b = table1();
         assert_eq!(b.simulation(&SimulationOverrides::default()).unwrap(), sc);
         assert_eq!(s.identification().unwrap(), b.identification().unwrap());
     }
@@ -550,7 +589,7 @@ duration = 1.0
 
     #[test]
     fn overrides_take_precedence_and_are_named_in_errors() {
-        let s = ScenarioSpec::load("table1").unwrap();
+        let s = table1();
         let ov = SimulationOverrides {
             dt: Some(2e-4),
             duration: Some(0.5),
@@ -565,7 +604,7 @@ duration = 1.0
             dt: Some(-1.0),
             ..Default::default()
         };
-        let e = format!("{:#}", s.simulation(&bad).unwrap_err());
+        let e = format!("{}", s.simulation(&bad).unwrap_err());
         assert_eq!(
             e,
             "table1: --dt = -1 is out of range: must be finite and > 0 (s)"
@@ -574,7 +613,7 @@ duration = 1.0
             vx: Some(f64::NAN),
             ..Default::default()
         };
-        let e = format!("{:#}", s.simulation(&bad).unwrap_err());
+        let e = format!("{}", s.simulation(&bad).unwrap_err());
         assert!(e.contains("--initial-vx = NaN is out of range"), "{e}");
     }
 
@@ -690,16 +729,189 @@ duration = 1.0
         assert!((v.alpha - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
         // ... and simulate says what is missing.
         let e = format!(
-            "{:#}",
+            "{}",
             s.simulation(&SimulationOverrides::default()).unwrap_err()
         );
         assert!(e.starts_with("id.toml: missing key rotor.m (kg)"), "{e}");
         let s =
             ScenarioSpec::parse("id.toml", "[rotor]\na = 2.871\nm_u = 1e-4\nd = 0.15\n").unwrap();
-        let e = format!("{:#}", s.identification().unwrap_err());
+        let e = format!("{}", s.identification().unwrap_err());
         assert!(
             e.starts_with("id.toml: missing key rotor.alpha_deg (deg)"),
             "{e}"
+        );
+    }
+
+    /// TABLE1 written with dotted keys only, one key a line (line 1 is `rotor.m`).
+    fn dotted_table1() -> String {
+        let mut out = String::new();
+        let mut section = "";
+        for line in TABLE1.lines().filter(|l| !l.is_empty()) {
+            match line.strip_prefix('[') {
+                Some(name) => section = name.trim_end_matches(']'),
+                None => out += &format!("{section}.{line}\n"),
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn dotted_keys_are_the_same_file() {
+        let text = dotted_table1();
+        assert!(
+            text.starts_with("rotor.m = 14.29\nrotor.cx = 10.0\n"),
+            "{text}"
+        );
+        let s = ScenarioSpec::parse("d.toml", &text).unwrap();
+        assert_eq!(
+            s.simulation(&SimulationOverrides::default()).unwrap(),
+            Scenario::table1()
+        );
+        assert_eq!(
+            s.identification().unwrap(),
+            table1().identification().unwrap()
+        );
+    }
+
+    #[test]
+    fn dotted_keys_are_named_at_their_own_line() {
+        let text = dotted_table1();
+        let e = err(&text.replace("rotor.kx = 1.195e6", "rotor.kx = -5"));
+        assert_eq!(
+            e,
+            "s.toml:4: rotor.kx = -5 is out of range: must be finite and > 0 (N/m)"
+        );
+        let e = err(&text.replace("sampling.dt = 1.0e-4", "sampling.dt = 0"));
+        assert!(
+            e.starts_with("s.toml:12: sampling.dt = 0 is out of range"),
+            "{e}"
+        );
+        let e = err(&text.replace("rotor.kz = 1195000", "rotor.kzz = 1195000"));
+        assert!(
+            e.starts_with("s.toml:5: unknown key rotor.kzz; allowed keys"),
+            "{e}"
+        );
+        let e = err(&text.replace("rotor.a = 2.871", "rotor.a.b = 2.871"));
+        assert!(
+            e.starts_with("s.toml:6: rotor.a = {...} has the wrong type: must be a number"),
+            "{e}"
+        );
+        // A section's line is that of its first dotted key.
+        let e = err(&text.replace("speed.rpm = 1200.0\n", ""));
+        assert_eq!(
+            e,
+            "s.toml:10: missing key speed.rpm (rev/min) for kind = \"constant\""
+        );
+        let e = err(&text.replace("rotor.m = 14.29\n", ""));
+        assert!(
+            e.starts_with("s.toml: missing key rotor.m (kg) (section [rotor] at line 1)"),
+            "{e}"
+        );
+        let e = err(&format!("{text}rotor.m = 1\n"));
+        assert!(
+            e.starts_with("s.toml:14: invalid TOML: duplicate key `m`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn inline_tables_and_mixed_forms_are_the_same_file() {
+        let text = "\
+rotor = { m = 14.29, cx = 10.0, cz = 10.0, kx = 1.195e6, kz = 1195000, a = 2.871, m_u = 1.0e-4, d = 0.15, alpha_deg = 45.0 }
+speed.kind = \"constant\"
+speed.rpm = 1200.0
+[sampling]
+dt = 1.0e-4
+duration = 1.0
+";
+        let s = ScenarioSpec::parse("i.toml", text).unwrap();
+        assert_eq!(
+            s.simulation(&SimulationOverrides::default()).unwrap(),
+            Scenario::table1()
+        );
+        let text = "sampling = { dt = 1.0e-4, duration = 1.0 }\n\n".to_owned() + TABLE1;
+        let text = text.replace("[sampling]\ndt = 1.0e-4\nduration = 1.0\n", "");
+        let s = ScenarioSpec::parse("i.toml", &text).unwrap();
+        assert_eq!(
+            s.simulation(&SimulationOverrides::default()).unwrap(),
+            Scenario::table1()
+        );
+    }
+
+    #[test]
+    fn inline_table_entries_are_named_at_their_line() {
+        let text = "\
+# a rotor
+rotor = { a = 2.871, m_u = 1e-4, d = 0.15, alpha_deg = 45 }
+
+speed = { kind = \"ramp\", rpm0 = 0, accel = 10 }
+initial = { x = 1e-6 }
+";
+        let s = ScenarioSpec::parse("i.toml", text).unwrap();
+        assert!(matches!(
+            s.identification().unwrap().speed,
+            Some(SpeedProfile::Ramp { accel, .. }) if accel == 10.0
+        ));
+        let e = err(&text.replace("d = 0.15", "d = -1"));
+        assert_eq!(
+            e,
+            "s.toml:2: rotor.d = -1 is out of range: must be finite and >= 0 (m)"
+        );
+        let e = err(&text.replace("m_u = 1e-4", "m_u = \"tiny\""));
+        assert!(
+            e.starts_with(
+                "s.toml:2: rotor.m_u = \"tiny\" has the wrong type: must be a number (kg)"
+            ),
+            "{e}"
+        );
+        let e = err(&text.replace("kind = \"ramp\"", "kind = \"sine\""));
+        assert!(
+            e.starts_with("s.toml:4: speed.kind = \"sine\" is not a speed profile"),
+            "{e}"
+        );
+        let e = err(&text.replace("accel = 10", "rpm = 10"));
+        assert!(
+            e.starts_with("s.toml:4: speed.rpm does not apply to kind = \"ramp\""),
+            "{e}"
+        );
+        let e = err(&text.replace("{ x = 1e-6 }", "{ x = [1] }"));
+        assert!(
+            e.starts_with("s.toml:5: initial.x = [1] has the wrong type"),
+            "{e}"
+        );
+        let e = err(&text.replace("rotor = {", "rotor = 3 #"));
+        assert_eq!(
+            e,
+            "s.toml:2: `rotor` must be a section [rotor], found an integer"
+        );
+    }
+
+    #[test]
+    fn errors_carry_their_parts() {
+        let text = TABLE1
+            .replace("kx = 1.195e6", "kx = -5")
+            .replace('\n', "\r\n");
+        let e = ScenarioSpec::parse("rig.toml", &text).unwrap_err();
+        assert_eq!((e.origin(), e.line()), ("rig.toml", Some(6)));
+        let ScenarioFileError::OutOfRange {
+            key,
+            value,
+            allowed,
+            ..
+        } = e
+        else {
+            panic!("not out of range: {e:?}")
+        };
+        assert_eq!(
+            (key.as_str(), value, allowed.as_str()),
+            ("rotor.kx", -5.0, "finite and > 0 (N/m)")
+        );
+        let e =
+            ScenarioSpec::parse("rig.toml", "[speed]\nkind = \"constant\"\nrpm = 1\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "rig.toml: missing section [rotor] (a, m_u, d, alpha_deg and, to simulate, m, cx, \
+             cz, kx, kz)"
         );
     }
 }
