@@ -7,9 +7,11 @@
 //! - [`simulate`]: Newmark (as in the paper) and an exact/high-accuracy reference, noise.
 //! - [`identify`]: running integrals and the algebraic identifiers, streaming and batch.
 //! - [`refine`]: output-error (maximum-likelihood) refinement with uncertainties.
+//! - [`analysis`]: Campbell diagram, critical speeds, stability, unbalance response, balancing.
 //!
 //! Pure computation: no file I/O, no plotting (those live in the `rotorid` command).
 
+pub mod analysis;
 pub mod identify;
 pub mod model;
 pub mod refine;
