@@ -238,6 +238,17 @@ impl ParameterCovariance {
             .is_some_and(|i| !self.undetermined[i])
     }
 
+    /// The standard deviation of a linearised result y = sum_i g_i theta_i, the gradient
+    /// given as (parameter, g_i) pairs (the others 0): sqrt(g^T Sigma g) (module doc);
+    /// `None` when it depends on an undetermined parameter.
+    pub fn std_of_linear(&self, gradient: &[(Parameter, f64)]) -> Option<f64> {
+        let mut g = [0.0; NPARAM];
+        for &(p, v) in gradient {
+            g[p.index()] += v;
+        }
+        self.propagate(&g)
+    }
+
     /// The standard deviation sqrt(g^T Sigma g) of a result with gradient `g` (module
     /// doc); `None` when it depends on an undetermined parameter.
     pub(crate) fn propagate(&self, g: &Gradient) -> Option<f64> {
