@@ -313,6 +313,18 @@ fn moved(p: &RotorParams, d: &DVector<f64>) -> RotorParams {
     )
 }
 
+/// `m` with parameter `i` undetermined, as the refinement writes it: an infinite variance
+/// and NaN in the rest of its row and column.
+fn undetermined(m: &[Vec<f64>], i: usize) -> Vec<Vec<f64>> {
+    let mut m = m.to_vec();
+    for row in m.iter_mut() {
+        row[i] = f64::NAN;
+    }
+    m[i].fill(f64::NAN);
+    m[i][i] = f64::INFINITY;
+    m
+}
+
 fn std_dev(v: &[f64]) -> f64 {
     let n = v.len() as f64;
     let mean = v.iter().sum::<f64>() / n;
@@ -386,25 +398,13 @@ fn linearised_standard_deviations_agree_with_monte_carlo() {
 
     // an undetermined parameter the critical speeds do not depend on leaves their std
     // alone; one they depend on removes it
-    let mut m = pc.matrix().to_vec();
-    for k in 0..8 {
-        m[6][k] = f64::NAN;
-        m[k][6] = f64::NAN;
-    }
-    m[6][6] = f64::INFINITY;
     let names = pc.names().to_vec();
-    let u_bad = ParameterCovariance::new(names.clone(), m).unwrap();
+    let u_bad = ParameterCovariance::new(names.clone(), undetermined(pc.matrix(), 6)).unwrap();
     let c = critical_speeds(&p, Some(&u_bad), &speeds).unwrap();
     assert_eq!(c[0].std, cs[0].std);
     let r = unbalance_response(&p, Some(&u_bad), &[probe_speed], &[Probe::X]).unwrap();
     assert_eq!(r.channels[0].points[0].unwrap().std_amplitude, None);
-    let mut m = pc.matrix().to_vec();
-    for k in 0..8 {
-        m[0][k] = f64::NAN;
-        m[k][0] = f64::NAN;
-    }
-    m[0][0] = f64::INFINITY;
-    let m_bad = ParameterCovariance::new(names, m).unwrap();
+    let m_bad = ParameterCovariance::new(names, undetermined(pc.matrix(), 0)).unwrap();
     assert_eq!(m_bad.std(Parameter::M), None);
     let c = critical_speeds(&p, Some(&m_bad), &speeds).unwrap();
     assert_eq!((c[0].std, c[1].std), (None, None));

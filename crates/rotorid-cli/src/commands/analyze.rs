@@ -532,37 +532,43 @@ pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The response's amplitude \[unit pk-pk\] and phase lag \[deg\] series of channel `i`.
-fn channel_series(
-    r: &Results,
-    i: usize,
-    per_m: f64,
-) -> (Vec<f64>, Vec<Option<f64>>, Vec<f64>, Vec<Option<f64>>) {
-    let ch = &r.response.channels[i];
-    let amp = ch
-        .points
-        .iter()
-        .map(|v| v.map_or(f64::NAN, |v| v.amplitude * per_m))
-        .collect();
-    let s_amp = ch
-        .points
-        .iter()
-        .map(|v| v.and_then(|v| v.std_amplitude).map(|s| s * per_m))
-        .collect();
-    let lag: Vec<f64> = ch
-        .points
-        .iter()
-        .map(|v| {
-            v.and_then(|v| v.phase_lag)
-                .map_or(f64::NAN, f64::to_degrees)
-        })
-        .collect();
-    let s_lag = ch
-        .points
-        .iter()
-        .map(|v| v.and_then(|v| v.std_phase_lag).map(f64::to_degrees))
-        .collect();
-    (amp, s_amp, lag, s_lag)
+/// One channel's response as plotted and written.
+struct ChannelSeries {
+    /// Amplitude per speed \[unit pk-pk\]; NaN where unbounded.
+    amplitude: Vec<f64>,
+    /// Its standard deviation \[unit pk-pk\].
+    std_amplitude: Vec<Option<f64>>,
+    /// Phase lag per speed \[deg\] in \[0, 360); NaN where undefined.
+    lag_deg: Vec<f64>,
+    /// Its standard deviation \[deg\].
+    std_lag_deg: Vec<Option<f64>>,
+}
+
+/// The response's series of channel `i`, amplitudes in the unit of `per_m` (per metre
+/// of peak amplitude).
+fn channel_series(r: &Results, i: usize, per_m: f64) -> ChannelSeries {
+    let pts = &r.response.channels[i].points;
+    ChannelSeries {
+        amplitude: pts
+            .iter()
+            .map(|v| v.map_or(f64::NAN, |v| v.amplitude * per_m))
+            .collect(),
+        std_amplitude: pts
+            .iter()
+            .map(|v| v.and_then(|v| v.std_amplitude).map(|s| s * per_m))
+            .collect(),
+        lag_deg: pts
+            .iter()
+            .map(|v| {
+                v.and_then(|v| v.phase_lag)
+                    .map_or(f64::NAN, f64::to_degrees)
+            })
+            .collect(),
+        std_lag_deg: pts
+            .iter()
+            .map(|v| v.and_then(|v| v.std_phase_lag).map(f64::to_degrees))
+            .collect(),
+    }
 }
 
 const CHANNEL_COLOURS: [Rgb; 6] = [
@@ -623,21 +629,21 @@ fn write_figures(
     let mut bode_channels = Vec::new();
     let mut polar_channels = Vec::new();
     for (i, name) in r.names.iter().enumerate() {
-        let (amp, s_amp, lag, s_lag) = channel_series(r, i, per_m);
+        let s = channel_series(r, i, per_m);
         let color = CHANNEL_COLOURS[i % CHANNEL_COLOURS.len()];
         polar_channels.push(PolarChannel {
             label: channel_label(name),
             color,
-            amplitude: amp.clone(),
-            phase_lag_deg: lag.clone(),
+            amplitude: s.amplitude.clone(),
+            phase_lag_deg: s.lag_deg.clone(),
         });
         bode_channels.push(BodeChannel {
             label: channel_label(name),
             color,
-            amplitude: amp,
-            std_amplitude: s_amp,
-            phase_lag_deg: unwrap_deg(&lag),
-            std_phase_lag_deg: s_lag,
+            amplitude: s.amplitude,
+            std_amplitude: s.std_amplitude,
+            phase_lag_deg: unwrap_deg(&s.lag_deg),
+            std_phase_lag_deg: s.std_lag_deg,
         });
     }
     let unit = args.unit.label().to_string();
@@ -686,8 +692,9 @@ fn analysis_json(
         .enumerate()
         .map(|(i, name)| {
             let ch = &r.response.channels[i];
-            let (amp, s_amp, lag, s_lag) = channel_series(r, i, um);
-            let peak = amp
+            let s = channel_series(r, i, um);
+            let peak = s
+                .amplitude
                 .iter()
                 .enumerate()
                 .filter(|(_, a)| a.is_finite())
@@ -699,10 +706,10 @@ fn analysis_json(
             ChannelJson {
                 name: name.clone(),
                 probe_deg: ch.probe.angle.to_degrees(),
-                amplitude_um_pp: amp.iter().map(|&a| opt(a)).collect(),
-                std_amplitude_um_pp: s_amp,
-                phase_lag_deg: lag.iter().map(|&l| opt(l)).collect(),
-                std_phase_lag_deg: s_lag,
+                amplitude_um_pp: s.amplitude.iter().map(|&a| opt(a)).collect(),
+                std_amplitude_um_pp: s.std_amplitude,
+                phase_lag_deg: s.lag_deg.iter().map(|&l| opt(l)).collect(),
+                std_phase_lag_deg: s.std_lag_deg,
                 peak,
             }
         })

@@ -205,7 +205,8 @@ pub struct InfluenceBalance {
 fn correction_unbalance(v0: [C64; 2], v1: [C64; 2], t: C64) -> Option<(C64, [C64; 2])> {
     let h = [(v1[0] - v0[0]) / t, (v1[1] - v0[1]) / t];
     let s = h[0].norm_sqr() + h[1].norm_sqr();
-    if !(s > 0.0) || !s.is_finite() {
+    // NaN fails `s > 0.0`, so a NaN sum is rejected too
+    if !(s.is_finite() && s > 0.0) {
         return None;
     }
     let n = h[0].conj() * v0[0] + h[1].conj() * v0[1];

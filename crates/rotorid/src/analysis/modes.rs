@@ -208,7 +208,8 @@ impl Quadratic {
             }
             let next = l - p / dp;
             let pn = self.det(next);
-            if !(pn.norm() < p.norm()) {
+            // a NaN residual is no improvement either
+            if pn.norm().is_nan() || pn.norm() >= p.norm() {
                 break;
             }
             (l, p) = (next, pn);

@@ -82,7 +82,8 @@ pub fn one_x(signal: &[f64], phi: &[f64]) -> Result<Option<OneX>, AnalysisError>
     let d = ata.diagonal().map(|v| 1.0 / v.sqrt());
     let scaled = Matrix3::from_fn(|i, j| ata[(i, j)] * d[i] * d[j]);
     let eig = SymmetricEigen::new(scaled);
-    if !(eig.eigenvalues.min() > MIN_EIGENVALUE) {
+    let smallest = eig.eigenvalues.min();
+    if smallest.is_nan() || smallest <= MIN_EIGENVALUE {
         return Ok(None);
     }
     let inv_scaled = eig.eigenvectors
