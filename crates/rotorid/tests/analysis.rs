@@ -573,6 +573,11 @@ fn influence_coefficients_from_two_simulated_runs_balance_the_rotor() {
     );
     let before = amplitudes(&reference);
     let after = amplitudes(&simulate_with(&s, truth + c));
+    println!(
+        "influence coefficients: 1X reduction x {:.0}, z {:.0}",
+        before[0] / after[0],
+        before[1] / after[1]
+    );
     assert!(
         before[0] / after[0] >= 20.0 && before[1] / after[1] >= 20.0,
         "{before:?} -> {after:?}"

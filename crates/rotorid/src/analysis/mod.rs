@@ -31,6 +31,9 @@
 //! - `one_x`: the 1X vector of a sampled signal against the shaft angle.
 //! - `covariance`: [`ParameterCovariance`] and the delta method.
 //!
+//! Conventions, the checks against independent references and the measured figures are in
+//! `docs/analysis.md` of this repository.
+//!
 //! ```
 //! use rotorid::analysis::{critical_speeds, Whirl};
 //! use rotorid::model::{rpm_to_rad_per_s, Rotor};
