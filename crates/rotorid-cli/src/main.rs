@@ -30,6 +30,10 @@ enum Command {
     Paper(commands::paper::PaperArgs),
     /// Plot a simulate or identify CSV as PNG or SVG.
     Plot(commands::plot::PlotArgs),
+    /// Campbell diagram, critical speeds, stability and unbalance response, with uncertainty.
+    Analyze(commands::analyze::AnalyzeArgs),
+    /// Correction mass for single-plane balancing (identified unbalance or two runs).
+    Balance(commands::balance::BalanceArgs),
 }
 
 fn main() {
@@ -40,6 +44,8 @@ fn main() {
         Command::Demo(args) => commands::demo::run(args),
         Command::Paper(args) => commands::paper::run(args),
         Command::Plot(args) => commands::plot::run(args),
+        Command::Analyze(args) => commands::analyze::run(args),
+        Command::Balance(args) => commands::balance::run(args),
     };
     if let Err(err) = result {
         eprintln!("Error: {err:#}");

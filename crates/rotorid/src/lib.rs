@@ -9,12 +9,14 @@
 //! - [`refine`]: output-error (maximum-likelihood) refinement with uncertainties.
 //! - [`pipeline`]: record -> identification with diagnostics, the entry point of every
 //!   caller (batch [`pipeline::identify`] and streaming [`pipeline::Session`]).
+//! - [`analysis`]: Campbell diagram, critical speeds, stability, unbalance response, balancing.
 //! - `scenario_file` (feature `toml`): scenario files (rotor, speed, sampling, initial
 //!   state) parsed from TOML text, with errors naming file, line, key and allowed range.
 //!
 //! Pure computation: no file I/O (callers read files and hand over their text), no
 //! plotting (those live in the `rotorid` command).
 
+pub mod analysis;
 pub mod identify;
 pub mod model;
 pub mod parameter;

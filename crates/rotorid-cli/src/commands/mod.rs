@@ -1,5 +1,7 @@
 //! One module per subcommand; each exposes `XArgs` (clap) and `run(XArgs) -> anyhow::Result<()>`.
 
+pub mod analyze;
+pub mod balance;
 pub mod demo;
 pub mod identify;
 pub mod paper;

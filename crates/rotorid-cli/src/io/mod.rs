@@ -5,7 +5,8 @@
 //! | scenario TOML (rotor, speed, sampling, initial state; SI) | [`scenario`] | you | simulate, identify |
 //! | response CSV `t,x,z,phi,phi_dot,phi_ddot` (s, m, m, rad, rad/s, rad/s^2) | [`response_csv`] | simulate | identify, plot |
 //! | estimates CSV `t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z` | [`estimates_csv`] | identify | plot |
-//! | summary JSON: the serialised `rotorid::pipeline::Identification` (docs/summary.md) | - | identify | scripts, analyze |
+//! | summary JSON: the serialised `rotorid::pipeline::Identification` (docs/summary.md) | - | identify | scripts |
+//! | summary JSON: identified `rotor`, `covariance` | [`identified`] | identify | analyze, balance |
 //!
 //! Numbers are written in shortest round-trip form ([`number`]): reading a value back gives
 //! the identical `f64`. Readers report errors as `FILE line L, column C (NAME): ...`
@@ -15,6 +16,7 @@
 pub mod columns;
 pub mod csv_error;
 pub mod estimates_csv;
+pub mod identified;
 pub mod number;
 pub mod output;
 pub mod params;

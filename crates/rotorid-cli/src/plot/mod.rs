@@ -10,9 +10,14 @@
 //!
 //! [`save`] picks the format from the file extension (`.png` or `.svg`). Text uses the
 //! embedded DejaVu Sans ([`font`]).
+//! The analysis figures ([`campbell`], [`bode`], [`polar`]) draw markers, bands and a colour scale through [`canvas`].
 
+pub mod bode;
+pub mod campbell;
+pub mod canvas;
 pub mod font;
 pub mod geometry;
+pub mod polar;
 mod render;
 pub mod scale;
 pub mod ticks;

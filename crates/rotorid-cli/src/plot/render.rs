@@ -125,7 +125,7 @@ pub(super) fn render(fig: &Figure, path: &Path, format: ImageFormat) -> anyhow::
 }
 
 /// Average an RGB image of `bw x bh` pixels over `s x s` blocks (module doc).
-fn box_downsample(big: &[u8], bw: u32, bh: u32, s: u32) -> Vec<u8> {
+pub(super) fn box_downsample(big: &[u8], bw: u32, bh: u32, s: u32) -> Vec<u8> {
     let (w, h) = (bw / s, bh / s);
     let n = s * s;
     let mut out = vec![0u8; 3 * (w * h) as usize];

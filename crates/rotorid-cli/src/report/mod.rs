@@ -7,7 +7,9 @@
 //!   parameter and direction, beside the paper's reported times.
 //! - [`figures`]: the paper's figures 2-9 (window 0.1-0.23 s and whole record).
 //! - [`tables`], [`markdown`], [`html`]: the documents; [`format`]: their numbers.
+//! - [`analysis`]: the page of `rotorid analyze` (critical speeds, stability, response).
 
+pub mod analysis;
 pub mod experiment;
 pub mod figures;
 pub mod format;

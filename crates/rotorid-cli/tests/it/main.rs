@@ -2,6 +2,8 @@
 
 mod common;
 
+mod analysis;
+
 mod demo;
 mod golden;
 mod identify;

@@ -1,0 +1,337 @@
+//! End-to-end tests of `rotorid analyze` and `rotorid balance`: the table1 Campbell
+//! diagram's two critical speeds (closed form k / (m -/+ a)), the uncertainty carried from
+//! a summary's covariance, the figures and the page, the correction mass from an
+//! identified unbalance and from two simulated runs, and clear errors.
+
+use std::path::Path;
+
+use crate::common::{data, rotorid};
+use predicates::prelude::PredicateBooleanExt;
+use predicates::str::contains;
+use serde_json::Value;
+
+fn png_size(path: &Path) -> (u32, u32) {
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let reader = decoder.read_info().unwrap();
+    let info = reader.info();
+    (info.width, info.height)
+}
+
+fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Zero-damping critical speeds of table1 \[rpm\]: W^2 = k / (m + a), k / (m - a).
+fn table1_critical_rpm() -> [f64; 2] {
+    let (m, k, a) = (14.29f64, 1.195e6f64, 2.871f64);
+    [(k / (m + a)).sqrt(), (k / (m - a)).sqrt()].map(|w| w * 60.0 / std::f64::consts::TAU)
+}
+
+#[test]
+fn table1_campbell_has_two_critical_speeds_below_3500_rpm() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("a");
+    rotorid()
+        .args(["analyze", "--scenario", "table1", "--out"])
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout(
+            contains("backward")
+                .and(contains("forward"))
+                .and(contains("stable")),
+        );
+    let j = read_json(&out.join("analysis.json"));
+    let cs = j["critical_speeds"].as_array().unwrap();
+    assert_eq!(cs.len(), 2, "{cs:?}");
+    let want = table1_critical_rpm();
+    for (c, (w, whirl)) in cs.iter().zip(want.iter().zip(["backward", "forward"])) {
+        let rpm = c["rpm"].as_f64().unwrap();
+        // damping 1e-3 moves them by ~1e-6 relative
+        assert!((rpm - w).abs() < 0.05, "{rpm} vs {w}");
+        assert!(rpm < 3500.0);
+        assert_eq!(c["whirl"], whirl);
+        assert!(c["std_rpm"].is_null(), "no covariance, no std: {c}");
+    }
+    let camp = &j["campbell"];
+    assert_eq!(camp["rpm"].as_array().unwrap().len(), 601);
+    assert_eq!(camp["modes"][0]["whirl"], "backward");
+    assert_eq!(camp["modes"][1]["whirl"], "forward");
+    // sqrt(k/m) = 46.0 Hz at rest for both modes
+    for m in 0..2 {
+        let f0 = camp["modes"][m]["frequency_hz"][0].as_f64().unwrap();
+        assert!((f0 - 46.03).abs() < 0.01, "{f0}");
+    }
+    assert_eq!(j["stability"]["stable"], true);
+    assert!(j["stability"]["threshold_rpm"].is_null());
+    let ld = j["stability"]["min_log_dec"].as_f64().unwrap();
+    assert!(ld > 0.006 && ld < 0.009, "{ld}");
+    // the unbalance excites the forward mode only (isotropic supports): one peak, there
+    for ch in j["unbalance_response"]["channels"].as_array().unwrap() {
+        let peak = ch["peak"]["rpm"].as_f64().unwrap();
+        assert!((peak - want[1]).abs() < 1.0, "{peak}");
+    }
+    for stem in ["campbell", "bode", "polar"] {
+        let (w, h) = png_size(&out.join(format!("{stem}.png")));
+        assert!(w >= 1200 && h >= 800, "{stem}: {w} x {h}");
+        let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).unwrap();
+        assert!(svg.starts_with("<svg"), "{stem}");
+    }
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert_eq!(html.matches("data:image/png;base64,").count(), 3);
+    assert!(html.contains("2519.9") && html.contains("3089.2"));
+}
+
+#[test]
+fn a_summary_carries_its_covariance_into_every_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("a");
+    rotorid()
+        .arg("analyze")
+        .arg(data("identified_table1.json"))
+        .args([
+            "--rpm",
+            "0:4000:20",
+            "--probe",
+            "45",
+            "--unit",
+            "mil",
+            "--out",
+        ])
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout(contains("\u{b1}"));
+    let j = read_json(&out.join("analysis.json"));
+    let cs = j["critical_speeds"].as_array().unwrap();
+    assert_eq!(cs.len(), 2);
+    for c in cs {
+        // m, k to ~5e-5 (40 dB): the critical speeds to ~0.015 rpm
+        let s = c["std_rpm"].as_f64().unwrap();
+        assert!(s > 1e-3 && s < 0.1, "{c}");
+    }
+    assert_eq!(
+        j["rotor_std"]["a"], 0.0,
+        "a is known: not in the covariance"
+    );
+    assert!(j["rotor_std"]["m"].as_f64().unwrap() > 0.0);
+    let chs = j["unbalance_response"]["channels"].as_array().unwrap();
+    assert_eq!(chs.len(), 3);
+    assert_eq!(chs[2]["probe_deg"], 45.0);
+    // a standard deviation wherever the response is defined above standstill
+    let amp = chs[0]["std_amplitude_um_pp"].as_array().unwrap();
+    assert!(amp[1..].iter().all(|v| v.as_f64().is_some_and(|s| s > 0.0)));
+    let svg = std::fs::read_to_string(out.join("bode.svg")).unwrap();
+    assert!(svg.contains("mil pk-pk"));
+}
+
+#[test]
+fn analyze_names_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("identified_table1.json")).unwrap();
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, text.replace("\"kz\": 1195022.02,", "")).unwrap();
+    rotorid()
+        .arg("analyze")
+        .arg(&bad)
+        .arg("--out")
+        .arg(dir.path().join("a"))
+        .assert()
+        .failure()
+        .stderr(contains("bad.json: missing field `rotor.kz` (N/m)"));
+    rotorid()
+        .args([
+            "analyze",
+            "--scenario",
+            "table1",
+            "--rpm",
+            "0:6000:0",
+            "--out",
+        ])
+        .arg(dir.path().join("b"))
+        .assert()
+        .failure()
+        .stderr(contains("STEP = 0 must be > 0"));
+    rotorid()
+        .arg("analyze")
+        .arg(data("identified_table1.json"))
+        .args(["--scenario", "table1", "--out"])
+        .arg(dir.path().join("c"))
+        .assert()
+        .failure()
+        .stderr(contains("cannot be used with"));
+    rotorid()
+        .args(["analyze", "--scenario"])
+        .arg(data("known_only.toml"))
+        .arg("--out")
+        .arg(dir.path().join("d"))
+        .assert()
+        .failure()
+        .stderr(contains("missing key rotor.m"));
+}
+
+#[test]
+fn balance_from_the_identified_unbalance() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("balance.json");
+    rotorid()
+        .arg("balance")
+        .arg(data("identified_table1.json"))
+        .args(["--radius", "0.15", "--rpm", "3000", "--out"])
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout(contains("keyphasor"));
+    let j = read_json(&out);
+    // mud = 1.5000674e-5 kg m at alpha = 0.7853791 rad: mass mud / R opposite it
+    let mass = j["mass_kg"].as_f64().unwrap();
+    assert!((mass - 1.5000674e-5 / 0.15).abs() < 1e-12, "{mass}");
+    let angle = j["angle_deg"].as_f64().unwrap();
+    assert!(
+        (angle - (0.7853791f64.to_degrees() + 180.0)).abs() < 1e-6,
+        "{angle}"
+    );
+    let (sm, sa) = (
+        j["std_mass_kg"].as_f64().unwrap(),
+        j["std_angle_deg"].as_f64().unwrap(),
+    );
+    assert!(
+        sm > 0.0 && sm < 1e-3 * mass && sa > 0.0 && sa < 0.1,
+        "{sm} {sa}"
+    );
+    let reduction = j["predicted_reduction"].as_f64().unwrap();
+    assert!(reduction > 1000.0, "{reduction}");
+    let at = &j["at_speed"];
+    let (before, after) = (
+        at["before_um_pp"]["x"].as_f64().unwrap(),
+        at["after_um_pp"]["x"].as_f64().unwrap(),
+    );
+    assert!((before / after / reduction - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn balance_from_a_reference_and_a_trial_run() {
+    // table1 (1.5e-5 kg m at 45 deg) and the same rotor with 0.2 g at 0.1 m, 200 deg added
+    let dir = tempfile::tempdir().unwrap();
+    let (u0, t) = ((1.5e-5f64, 45f64), (2e-5f64, 200f64));
+    let (re, im) = (
+        u0.0 * u0.1.to_radians().cos() + t.0 * t.1.to_radians().cos(),
+        u0.0 * u0.1.to_radians().sin() + t.0 * t.1.to_radians().sin(),
+    );
+    let scenario = std::fs::read_to_string(data("table1.toml"))
+        .unwrap()
+        .replace("m_u = 1.0e-4", &format!("m_u = {:e}", re.hypot(im) / 0.15))
+        .replace(
+            "alpha_deg = 45.0",
+            &format!("alpha_deg = {:e}", im.atan2(re).to_degrees()),
+        );
+    let trial_toml = dir.path().join("trial.toml");
+    std::fs::write(&trial_toml, scenario).unwrap();
+    let run1 = dir.path().join("run1.csv");
+    let run2 = dir.path().join("run2.csv");
+    for (scenario, out) in [
+        (data("table1.toml"), &run1),
+        (trial_toml.display().to_string(), &run2),
+    ] {
+        rotorid()
+            .args(["simulate", "-q", "--scenario", &scenario, "--out"])
+            .arg(out)
+            .assert()
+            .success();
+    }
+    let out = dir.path().join("balance.json");
+    rotorid()
+        .args(["balance", "--reference"])
+        .arg(&run1)
+        .arg("--trial")
+        .arg(&run2)
+        .args([
+            "--trial-mass",
+            "2e-4",
+            "--trial-angle",
+            "200",
+            "--trial-radius",
+            "0.1",
+            "--radius",
+            "0.15",
+            "--out",
+        ])
+        .arg(&out)
+        .assert()
+        .success();
+    let j = read_json(&out);
+    assert_eq!(j["method"], "influence_coefficients");
+    // the correction cancels 1.5e-5 kg m at 45 deg: 1e-4 kg at 0.15 m, 225 deg
+    let mass = j["mass_kg"].as_f64().unwrap();
+    let angle = j["angle_deg"].as_f64().unwrap();
+    assert!((mass / 1e-4 - 1.0).abs() < 0.01, "{mass}");
+    assert!((angle - 225.0).abs() < 0.5, "{angle}");
+    assert!(j["std_mass_kg"].as_f64().unwrap() > 0.0);
+    let at = &j["at_speed"];
+    assert!((at["rpm"].as_f64().unwrap() - 1200.0).abs() < 1e-6);
+    for d in ["x", "z"] {
+        let (b, a) = (
+            at["before_um_pp"][d].as_f64().unwrap(),
+            at["after_um_pp"][d].as_f64().unwrap(),
+        );
+        assert!(b / a > 20.0, "{d}: {b} -> {a}");
+    }
+
+    // without phi columns the shaft angle needs a scenario
+    let text = std::fs::read_to_string(&run1).unwrap();
+    let no_phi: String = text
+        .lines()
+        .map(|l| l.splitn(4, ',').take(3).collect::<Vec<_>>().join(",") + "\n")
+        .collect();
+    let bare = dir.path().join("bare.csv");
+    std::fs::write(&bare, no_phi).unwrap();
+    rotorid()
+        .args(["balance", "--reference"])
+        .arg(&bare)
+        .arg("--trial")
+        .arg(&run2)
+        .args([
+            "--trial-mass",
+            "2e-4",
+            "--trial-angle",
+            "200",
+            "--radius",
+            "0.15",
+        ])
+        .assert()
+        .failure()
+        .stderr(contains("bare.csv has no phi, phi_dot, phi_ddot columns"));
+    // --rpm selects samples by speed: none at 1500 rpm in a 1200 rpm run
+    rotorid()
+        .args(["balance", "--reference"])
+        .arg(&run1)
+        .arg("--trial")
+        .arg(&run2)
+        .args([
+            "--trial-mass",
+            "2e-4",
+            "--trial-angle",
+            "200",
+            "--radius",
+            "0.15",
+            "--rpm",
+            "1500",
+        ])
+        .assert()
+        .failure()
+        .stderr(contains("0 samples within 1 % of 1500 rpm"));
+}
+
+#[test]
+fn balance_help_states_the_angle_convention() {
+    rotorid()
+        .args(["balance", "--help"])
+        .assert()
+        .success()
+        .stdout(contains("keyphasor reference").and(contains("direction of rotation")));
+    rotorid()
+        .args(["balance", "--radius", "0.1"])
+        .assert()
+        .failure()
+        .stderr(contains("give an identification summary"));
+}

@@ -1,0 +1,350 @@
+//! The parameters' covariance and first-order (delta-method) propagation through a result.
+//!
+//! The parameters are those of the refinement's internal parametrisation
+//! (`refine::Refined::covariance`): m, cx, kx, cz, kz, a and the unbalance as
+//! u_c = m_u d cos(alpha), u_s = m_u d sin(alpha), in which the unbalance force is linear.
+//! For a result y = f(theta) with gradient g = df/dtheta at the estimate,
+//!
+//! ```text
+//! var(y) ~ g^T Sigma g = sum_ij g_i g_j Sigma_ij
+//! ```
+//!
+//! over the parameters the covariance names; a parameter it does not name is taken as
+//! known exactly (zero variance). A parameter whose variance is NaN or infinite is
+//! undetermined (the refinement writes an infinite variance, and NaN in the rest of the
+//! row and column, for the parameters the data could not separate); so, conservatively,
+//! are both parameters of a non-finite covariance between two finite variances. A result
+//! that depends on an undetermined parameter (g_i != 0) has no standard deviation
+//! (`None`); a result that does not (g_i = 0, e.g. a critical speed and the unbalance) is
+//! unaffected.
+//! Reference: the delta method, e.g. Casella & Berger, *Statistical Inference*, 2nd ed.,
+//! 2002, sec. 5.5.4.
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::refine::Refined;
+
+use super::error::AnalysisError;
+
+/// A model parameter the analysis propagates uncertainty from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum Parameter {
+    /// m \[kg\].
+    M,
+    /// cx \[N s/m\].
+    Cx,
+    /// kx \[N/m\].
+    Kx,
+    /// cz \[N s/m\].
+    Cz,
+    /// kz \[N/m\].
+    Kz,
+    /// Gyroscopic coefficient a \[N s^2/m\].
+    A,
+    /// u_c = m_u d cos(alpha) \[kg m\].
+    MudCosAlpha,
+    /// u_s = m_u d sin(alpha) \[kg m\].
+    MudSinAlpha,
+}
+
+/// The names [`ParameterCovariance::new`] accepts, for messages.
+pub const PARAMETER_NAMES: &str = "m, cx, kx, cz, kz, a, mud_cos_alpha, mud_sin_alpha";
+
+/// Number of parameters: the length of every gradient.
+pub(crate) const NPARAM: usize = 8;
+
+/// A gradient (or any vector) over the parameters, indexed by [`Parameter::index`].
+pub(crate) type Gradient = [f64; NPARAM];
+
+impl Parameter {
+    /// Every parameter, in index order.
+    pub const ALL: [Parameter; NPARAM] = [
+        Parameter::M,
+        Parameter::Cx,
+        Parameter::Kx,
+        Parameter::Cz,
+        Parameter::Kz,
+        Parameter::A,
+        Parameter::MudCosAlpha,
+        Parameter::MudSinAlpha,
+    ];
+
+    /// The name as the refinement writes it (`m`, ..., `mud_cos_alpha`, `mud_sin_alpha`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Parameter::M => "m",
+            Parameter::Cx => "cx",
+            Parameter::Kx => "kx",
+            Parameter::Cz => "cz",
+            Parameter::Kz => "kz",
+            Parameter::A => "a",
+            Parameter::MudCosAlpha => "mud_cos_alpha",
+            Parameter::MudSinAlpha => "mud_sin_alpha",
+        }
+    }
+
+    /// The parameter called `name`, if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// SI unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Parameter::M => "kg",
+            Parameter::Cx | Parameter::Cz => "N s/m",
+            Parameter::Kx | Parameter::Kz => "N/m",
+            Parameter::A => "N s^2/m",
+            Parameter::MudCosAlpha | Parameter::MudSinAlpha => "kg m",
+        }
+    }
+
+    /// Position in [`Parameter::ALL`].
+    pub(crate) fn index(self) -> usize {
+        self as usize
+    }
+}
+
+impl fmt::Display for Parameter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The value of every parameter at a rotor: (m, cx, kx, cz, kz, a, u_c, u_s).
+pub(crate) fn values(p: &crate::model::RotorParams) -> Gradient {
+    let mud = p.unbalance.mud();
+    let (s, c) = p.unbalance.alpha.sin_cos();
+    [p.m, p.cx, p.kx, p.cz, p.kz, p.a, mud * c, mud * s]
+}
+
+/// The covariance of a subset of the parameters (SI units of each, squared), e.g. that of
+/// a maximum-likelihood fit. Build it with [`ParameterCovariance::new`] (validated) or
+/// [`ParameterCovariance::from_refined`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ParameterCovariance {
+    names: Vec<String>,
+    matrix: Vec<Vec<f64>>,
+    #[serde(skip)]
+    params: Vec<Parameter>,
+    /// Per row: true when the parameter is undetermined (module doc).
+    #[serde(skip)]
+    undetermined: Vec<bool>,
+}
+
+impl ParameterCovariance {
+    /// A covariance over the parameters `names` (from [`PARAMETER_NAMES`], each at most
+    /// once) with `matrix[i][j]` = Cov(names\[i\], names\[j\]) in SI units. Errors: an unknown
+    /// or repeated name, a matrix that is not square with one row per name, a negative
+    /// variance. NaN or infinite entries are accepted: they mark undetermined parameters
+    /// (module doc).
+    pub fn new(names: Vec<String>, matrix: Vec<Vec<f64>>) -> Result<Self, AnalysisError> {
+        let mut params = Vec::with_capacity(names.len());
+        for name in &names {
+            let p = Parameter::from_name(name).ok_or_else(|| AnalysisError::UnknownParameter {
+                name: name.clone(),
+                allowed: PARAMETER_NAMES,
+            })?;
+            if params.contains(&p) {
+                return Err(AnalysisError::DuplicateParameter { name: name.clone() });
+            }
+            params.push(p);
+        }
+        let n = names.len();
+        if matrix.len() != n {
+            return Err(AnalysisError::NotSquare {
+                row: matrix.len(),
+                len: matrix.len(),
+                expected: n,
+            });
+        }
+        if let Some((row, r)) = matrix.iter().enumerate().find(|(_, r)| r.len() != n) {
+            return Err(AnalysisError::NotSquare {
+                row,
+                len: r.len(),
+                expected: n,
+            });
+        }
+        // undetermined: a non-finite variance; and, conservatively, both parameters of a
+        // non-finite covariance between two finite variances
+        let mut undetermined: Vec<bool> = (0..n).map(|i| !matrix[i][i].is_finite()).collect();
+        for i in 0..n {
+            for j in 0..n {
+                if !matrix[i][j].is_finite() && !undetermined[i] && !undetermined[j] {
+                    undetermined[i] = true;
+                    undetermined[j] = true;
+                }
+            }
+        }
+        for i in 0..n {
+            if !undetermined[i] && matrix[i][i] < 0.0 {
+                return Err(AnalysisError::NegativeVariance {
+                    name: names[i].clone(),
+                    value: matrix[i][i],
+                });
+            }
+        }
+        Ok(Self {
+            names,
+            matrix,
+            params,
+            undetermined,
+        })
+    }
+
+    /// The covariance of the model parameters of a fit (its initial-state rows x0, z0,
+    /// vx0, vz0 are nuisance parameters and are dropped; they do not enter the analysis).
+    pub fn from_refined(r: &Refined) -> Result<Self, AnalysisError> {
+        const NUISANCE: [&str; 4] = ["x0", "z0", "vx0", "vz0"];
+        let keep: Vec<usize> = (0..r.covariance_names.len())
+            .filter(|&i| !NUISANCE.contains(&r.covariance_names[i]))
+            .collect();
+        let names = keep
+            .iter()
+            .map(|&i| r.covariance_names[i].to_string())
+            .collect();
+        let matrix = keep
+            .iter()
+            .map(|&i| keep.iter().map(|&j| r.covariance[i][j]).collect())
+            .collect();
+        Self::new(names, matrix)
+    }
+
+    /// The parameter names, in row order.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The matrix, row-major, `matrix()[i][j]` = Cov(names\[i\], names\[j\]) (SI units).
+    pub fn matrix(&self) -> &[Vec<f64>] {
+        &self.matrix
+    }
+
+    /// The standard deviation of parameter `p`: `Some(0.0)` when the covariance does not
+    /// name it (known exactly), `None` when it is undetermined.
+    pub fn std(&self, p: Parameter) -> Option<f64> {
+        let mut g = [0.0; NPARAM];
+        g[p.index()] = 1.0;
+        self.propagate(&g)
+    }
+
+    /// True when the covariance names `p` and `p` is determined.
+    pub fn is_determined(&self, p: Parameter) -> bool {
+        self.params
+            .iter()
+            .position(|&q| q == p)
+            .is_some_and(|i| !self.undetermined[i])
+    }
+
+    /// The standard deviation of a linearised result y = sum_i g_i theta_i, the gradient
+    /// given as (parameter, g_i) pairs (the others 0): sqrt(g^T Sigma g) (module doc);
+    /// `None` when it depends on an undetermined parameter.
+    pub fn std_of_linear(&self, gradient: &[(Parameter, f64)]) -> Option<f64> {
+        let mut g = [0.0; NPARAM];
+        for &(p, v) in gradient {
+            g[p.index()] += v;
+        }
+        self.propagate(&g)
+    }
+
+    /// The standard deviation sqrt(g^T Sigma g) of a result with gradient `g` (module
+    /// doc); `None` when it depends on an undetermined parameter.
+    pub(crate) fn propagate(&self, g: &Gradient) -> Option<f64> {
+        Some(self.propagate_pair(g, g)?.max(0.0).sqrt())
+    }
+
+    /// The covariance g^T Sigma h of two results with gradients `g` and `h`; `None` when
+    /// either depends on an undetermined parameter.
+    pub(crate) fn propagate_pair(&self, g: &Gradient, h: &Gradient) -> Option<f64> {
+        let n = self.params.len();
+        let gi: Vec<f64> = self.params.iter().map(|p| g[p.index()]).collect();
+        let hi: Vec<f64> = self.params.iter().map(|p| h[p.index()]).collect();
+        for i in 0..n {
+            if self.undetermined[i] && (gi[i] != 0.0 || hi[i] != 0.0) {
+                return None;
+            }
+        }
+        let mut s = 0.0;
+        for i in (0..n).filter(|&i| !self.undetermined[i]) {
+            for j in (0..n).filter(|&j| !self.undetermined[j]) {
+                s += gi[i] * self.matrix[i][j] * hi[j];
+            }
+        }
+        Some(s)
+    }
+}
+
+/// The standard deviation of a result with gradient `g` under `cov`, `None` without a
+/// covariance (or when undetermined).
+pub(crate) fn std_of(cov: Option<&ParameterCovariance>, g: &Gradient) -> Option<f64> {
+    cov.and_then(|c| c.propagate(g))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(v: &[&str]) -> Vec<String> {
+        v.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn names_round_trip_and_are_validated() {
+        for p in Parameter::ALL {
+            assert_eq!(Parameter::from_name(p.name()), Some(p));
+            assert_eq!(Parameter::ALL[p.index()], p);
+        }
+        let e = ParameterCovariance::new(names(&["m", "k"]), vec![vec![1.0; 2]; 2]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "unknown parameter \"k\" in the covariance: expected names from m, cx, kx, cz, kz, a, mud_cos_alpha, mud_sin_alpha"
+        );
+        let e = ParameterCovariance::new(names(&["m", "m"]), vec![vec![1.0; 2]; 2]).unwrap_err();
+        assert!(matches!(e, AnalysisError::DuplicateParameter { .. }), "{e}");
+        let e = ParameterCovariance::new(names(&["m", "kx"]), vec![vec![1.0, 0.0], vec![0.0]])
+            .unwrap_err();
+        assert_eq!(
+            e,
+            AnalysisError::NotSquare {
+                row: 1,
+                len: 1,
+                expected: 2
+            }
+        );
+        let e = ParameterCovariance::new(names(&["m"]), vec![]).unwrap_err();
+        assert!(
+            matches!(e, AnalysisError::NotSquare { expected: 1, .. }),
+            "{e}"
+        );
+        let e = ParameterCovariance::new(names(&["m"]), vec![vec![-1.0]]).unwrap_err();
+        assert!(matches!(e, AnalysisError::NegativeVariance { .. }), "{e}");
+    }
+
+    #[test]
+    fn propagation_is_the_quadratic_form_and_skips_unrelated_undetermined_rows() {
+        // m, kx correlated; a undetermined (NaN row, inf diagonal as refine writes it)
+        let nan = f64::NAN;
+        let c = ParameterCovariance::new(
+            names(&["m", "kx", "a"]),
+            vec![
+                vec![4.0, 3.0, nan],
+                vec![3.0, 9.0, nan],
+                vec![nan, nan, f64::INFINITY],
+            ],
+        )
+        .unwrap();
+        let mut g = [0.0; NPARAM];
+        g[Parameter::M.index()] = 1.0;
+        g[Parameter::Kx.index()] = -2.0;
+        // 4 - 2 * 2 * 3 + 4 * 9 = 28
+        assert!((c.propagate(&g).unwrap() - 28f64.sqrt()).abs() < 1e-15);
+        assert_eq!(c.std(Parameter::M), Some(2.0));
+        assert_eq!(c.std(Parameter::Cz), Some(0.0));
+        assert_eq!(c.std(Parameter::A), None);
+        assert!(c.is_determined(Parameter::Kx) && !c.is_determined(Parameter::A));
+        g[Parameter::A.index()] = 1e-30;
+        assert_eq!(c.propagate(&g), None);
+    }
+}
