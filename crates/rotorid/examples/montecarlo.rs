@@ -1,4 +1,4 @@
-//! Monte Carlo study of the identifiers under white measurement noise (issue 5, item 5).
+//! Monte Carlo study of the identifiers under white measurement noise.
 //!
 //! ```text
 //! cargo run --release -p rotorid --example montecarlo [-- --seeds N] [--out PATH]
@@ -9,14 +9,14 @@
 //! T = 0.1, 0.3, 1 s; N noise seeds each (default 100). Noise per channel c in {x, z}:
 //! sigma_c = RMS(c over the record) 10^(-SNR/20) (method.md section 7, `add_noise`).
 //!
-//! Methods (a, m_u d and alpha known; m, cx, kx, cz, kz estimated):
-//! - plain: the paper's algebraic identifier (`identify_response`, default config) at the
-//!   last instant <= T where both directions are well conditioned;
-//! - modulating: `identify_modulating_response`, default config (window 20 ms, hop 2.5 ms,
-//!   3 test functions, noise bias compensated with sigma estimated from the data);
-//! - refine: `refine` (maximum likelihood, initial state estimated), started from the
-//!   modulating estimate (m the mean of its two directions' m; initial state 0), or from the
-//!   plain one if the modulating one is singular.
+//! Methods, each through `rotorid::pipeline::identify` with its defaults (a, m_u d and
+//! alpha known; m, cx, kx, cz, kz estimated):
+//! - plain: the paper's algebraic identifier, each direction's final estimate (its last
+//!   well-conditioned instant <= T);
+//! - modulating: window 20 ms, hop 2.5 ms, 3 test functions, noise bias compensated with
+//!   sigma estimated from the data;
+//! - refine: maximum likelihood, initial state estimated, from the pipeline's start
+//!   (docs/method.md section 5.2: the modulating estimate, else the early algebraic one).
 //!
 //! Per case, method and parameter: RMS relative error sqrt(mean(e^2)), bias mean(e), with
 //! e = estimate / truth - 1, and the coverage of the 95 % interval estimate +- 1.96 se
@@ -31,12 +31,13 @@ use std::fmt::Write as _;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
-use rotorid::identify::algebraic::{identify_response, AlgebraicConfig};
-use rotorid::identify::modulating::{identify_modulating_response, ModulatingConfig};
-use rotorid::identify::Known;
-use rotorid::model::{InitialState, RotorParams, Sampling, Scenario};
-use rotorid::refine::{crb_at_snr, refine, Record, RefineOptions, Unknowns};
+use rotorid::model::{RotorParams, Sampling, Scenario};
+use rotorid::pipeline::{
+    identify, Identification, Knowledge, Method as IdMethod, Record, StartSource,
+};
+use rotorid::refine::{crb_at_snr, Unknowns};
 use rotorid::simulate::{add_noise, simulate, Method, TimeResponse};
+use rotorid::Parameter;
 
 const NAMES: [&str; 5] = ["m", "cx", "kx", "cz", "kz"];
 const SNRS: [f64; 3] = [20.0, 40.0, 60.0];
@@ -242,92 +243,43 @@ fn finite(v: &[f64]) -> bool {
 fn run_one(case: &Case, index: usize, seed: u64) -> Run {
     let s = &case.scenario;
     let truth = s.rotor.params();
-    let known = Known::from_rotor(&s.rotor);
     let mut r = case.clean.clone();
     // distinct seeds per case and record
     add_noise(&mut r, case.snr, 1_000_000 * index as u64 + seed).expect("noise");
-
-    // plain algebraic: the last well-conditioned instant
-    let cfg = AlgebraicConfig::default();
-    let plain_values = identify_response(&r, known, cfg)
-        .ok()
-        .and_then(|est| {
-            est.iter()
-                .rev()
-                .find(|e| e.well_conditioned(cfg.rcond_min) == [true, true])
-                .map(|e| {
-                    let v = e.values();
-                    [v[0], v[1], v[2], v[4], v[5]]
-                })
-        })
-        .filter(|v| finite(v));
-    let plain: Outcome = plain_values.map(|v| (rel(&truth, v), None));
-
-    // modulating
-    let mcfg = ModulatingConfig::default();
-    let modulating_est = identify_modulating_response(&r, known, mcfg)
-        .ok()
-        .filter(|e| e.well_conditioned(mcfg.rcond_min) == [true, true]);
-    let modulating: Outcome = modulating_est.and_then(|e| {
-        let v = e.values();
-        let se = e.std_errors();
-        let vals = [v[0], v[1], v[2], v[4], v[5]];
-        let ses = [se[0], se[1], se[2], se[4], se[5]];
+    let rec = Record::from_response(&r).expect("a simulated record");
+    let k = Knowledge::from_scenario(s);
+    // Each method through the pipeline, as every caller runs it: values of m (the x
+    // direction's for the per-direction methods), cx, kx, cz, kz, even where withheld.
+    let run = |method: &IdMethod| identify(&rec, &k, method).ok();
+    let outcome = |id: &Option<Identification>, m: Parameter| -> Outcome {
+        let id = id.as_ref()?;
+        let of = |p: Parameter| id.parameter(p);
+        let ps = [
+            m,
+            Parameter::Cx,
+            Parameter::Kx,
+            Parameter::Cz,
+            Parameter::Kz,
+        ];
+        let vals = ps.map(|p| of(p).and_then(|r| r.estimate).unwrap_or(f64::NAN));
         if !finite(&vals) {
             return None;
         }
         let t = [truth.m, truth.cx, truth.kx, truth.cz, truth.kz];
+        let ses = ps.map(|p| of(p).and_then(|r| r.std_error).unwrap_or(f64::NAN));
         let rel_se = [0, 1, 2, 3, 4].map(|i| ses[i] / t[i]);
         Some((rel(&truth, vals), finite(&rel_se).then_some(rel_se)))
-    });
-
-    // refine from the modulating estimate (or the plain one)
-    let (start, from_plain) = match (modulating_est, plain_values) {
-        (Some(e), _) if finite(&e.values()) => (
-            Some([0.5 * (e.x.m + e.z.m), e.x.c, e.x.k, e.z.c, e.z.k]),
-            false,
-        ),
-        (_, Some(v)) => (Some(v), true),
-        _ => (None, false),
     };
-    let mut converged = false;
-    let refined: Outcome = start.and_then(|v| {
-        let p = RotorParams {
-            m: v[0],
-            cx: v[1],
-            kx: v[2],
-            cz: v[3],
-            kz: v[4],
-            ..truth
-        };
-        let rec = Record::from_simulation(s, &r);
-        let fit = refine(
-            &rec,
-            &p,
-            &InitialState::default(),
-            &RefineOptions::default(),
-        )
-        .ok()?;
-        converged = fit.converged;
-        let mut vals = [0.0; 5];
-        let mut ses = [0.0; 5];
-        for (i, n) in NAMES.iter().enumerate() {
-            let e = fit.get(n)?;
-            vals[i] = e.value;
-            ses[i] = e.std_error;
-        }
-        if !finite(&vals) {
-            return None;
-        }
-        let t = [truth.m, truth.cx, truth.kx, truth.cz, truth.kz];
-        let rel_se = [0, 1, 2, 3, 4].map(|i| ses[i] / t[i]);
-        Some((rel(&truth, vals), finite(&rel_se).then_some(rel_se)))
-    });
+    let plain = outcome(&run(&IdMethod::algebraic()), Parameter::MX);
+    let modulating = outcome(&run(&IdMethod::modulating()), Parameter::MX);
+    let fit = run(&IdMethod::refine());
+    let refined = outcome(&fit, Parameter::M);
+    let detail = fit.as_ref().and_then(|f| f.refine.as_ref());
     Run {
         case: index,
         outcomes: [plain, modulating, refined],
-        refine_converged: converged,
-        refine_from_plain: from_plain,
+        refine_converged: detail.is_some_and(|d| d.converged),
+        refine_from_plain: detail.is_some_and(|d| d.start.source == StartSource::Algebraic),
     }
 }
 

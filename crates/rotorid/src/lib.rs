@@ -25,6 +25,8 @@ pub mod refine;
 #[cfg(feature = "toml")]
 pub mod scenario_file;
 pub mod simulate;
+#[cfg(feature = "test-models")]
+pub mod test_models;
 
 pub use model::{
     InitialState, Rotor, RotorParams, Sampling, Scenario, SpeedProfile, SpeedState, Unbalance,

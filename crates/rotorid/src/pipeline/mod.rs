@@ -77,9 +77,10 @@ pub fn identify(
         Speed::Profile(p) => Some(*p),
         Speed::Samples { .. } => None,
     };
+    // The record's stamps were checked against its grid when it was built.
     let timing = Timing::Grid {
         grid: record.grid(),
-        tolerance: f64::INFINITY,
+        tolerance: f64::MAX,
     };
     let mut session = Session::new(knowledge, method, profile, timing)?;
     session.keep_estimates();

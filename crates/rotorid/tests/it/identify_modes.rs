@@ -2,9 +2,7 @@
 //! one and against an independent, slow, whole-array implementation of its formulas; batch
 //! against streaming.
 
-mod identify_common;
-
-use identify_common::*;
+use crate::identify_common::*;
 use nalgebra::{Matrix3, Vector3};
 use rotorid::identify::algebraic::{
     identify_batch, identify_response, measurement, AlgebraicConfig, AlgebraicIdentifier,

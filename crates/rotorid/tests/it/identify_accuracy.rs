@@ -2,9 +2,7 @@
 //! issue's targets): table1 at dt = 0.1 ms, 1200 rpm and the 10 rad/s^2 ramps from rest
 //! and from 1200 rpm, with zero and with non-zero initial conditions.
 
-mod identify_common;
-
-use identify_common::*;
+use crate::identify_common::*;
 use rotorid::identify::algebraic::{Quadrature, DEFAULT_ALGEBRAIC_RCOND_MIN};
 use rotorid::simulate::Method;
 use rotorid::Scenario;

@@ -1,9 +1,7 @@
 //! Calibration of the default conditioning threshold (`DEFAULT_ALGEBRAIC_RCOND_MIN`) on table1,
 //! exact data: the spikes where A(t) passes near singularity are flagged, the rest are not.
 
-mod identify_common;
-
-use identify_common::*;
+use crate::identify_common::*;
 use rotorid::identify::algebraic::{ConvergenceTracker, Quadrature, DEFAULT_ALGEBRAIC_RCOND_MIN};
 use rotorid::simulate::Method;
 

@@ -4,17 +4,7 @@
 use rotorid::model::{InitialState, Rotor, RotorParams, Scenario, SpeedProfile};
 use rotorid::refine::{refine, Record, RefineOptions, Refined, Unknowns, Warning};
 use rotorid::simulate::{add_noise, simulate, steady_state, Method};
-
-fn perturbed(p: &RotorParams) -> RotorParams {
-    RotorParams {
-        m: p.m * 1.01,
-        cx: p.cx * 0.99,
-        kx: p.kx * 0.99,
-        cz: p.cz * 1.01,
-        kz: p.kz * 1.01,
-        ..*p
-    }
-}
+use rotorid::test_models::perturbed_start as perturbed;
 
 fn fit(s: &Scenario, snr_db: Option<f64>, unknowns: Unknowns, start: &RotorParams) -> Refined {
     let mut resp = simulate(s, Method::Exact).unwrap();

@@ -6,19 +6,9 @@
 use rotorid::model::{InitialState, RotorParams, Scenario};
 use rotorid::refine::{crb_at_snr, refine, Record, RefineOptions, Unknowns};
 use rotorid::simulate::{add_noise, simulate, Method};
+use rotorid::test_models::perturbed_start;
 
 const NAMES: [&str; 5] = ["m", "cx", "kx", "cz", "kz"];
-
-fn start(p: &RotorParams) -> RotorParams {
-    RotorParams {
-        m: p.m * 1.01,
-        cx: p.cx * 0.99,
-        kx: p.kx * 0.99,
-        cz: p.cz * 1.01,
-        kz: p.kz * 1.01,
-        ..*p
-    }
-}
 
 struct Study {
     /// per parameter: RMS error / CRB, |mean error| / CRB, coverage of +-1.96 se
@@ -46,7 +36,7 @@ fn study(label: &str, s: &Scenario, seeds: u64) -> Study {
         let rec = Record::from_simulation(s, &resp);
         let r = refine(
             &rec,
-            &start(&truth),
+            &perturbed_start(&truth),
             &InitialState::default(),
             &RefineOptions::default(),
         )
@@ -124,32 +114,36 @@ fn hundred_seeds_efficiency_bias_and_coverage() {
     }
 }
 
-/// From the paper's algebraic identifier (its estimate at t = 0.05 s, before noise makes it
-/// drift; c there is often off by 100 % or more) the fit reaches the same optimum as from
-/// the truth.
+/// From the paper's algebraic identifier (its estimate over the first 0.05 s, before noise
+/// makes it drift; c there is often off by 100 % or more) the fit reaches the same optimum
+/// as from the truth.
 #[test]
 fn algebraic_start_reaches_the_same_optimum() {
-    use rotorid::identify::algebraic::{identify_response, AlgebraicConfig};
-    use rotorid::identify::Known;
+    use rotorid::pipeline::{identify, Knowledge, Method as Identification, Speed};
     for s in [Scenario::table1(), Scenario::table1_ramp(600.0).unwrap()] {
         let clean = simulate(&s, Method::Exact).unwrap();
         let truth = s.rotor.params();
         for seed in 0..5 {
             let mut resp = clean.clone();
             add_noise(&mut resp, 40.0, 2000 + seed).unwrap();
-            let est = identify_response(
-                &resp,
-                Known::from_rotor(&s.rotor),
-                AlgebraicConfig::default(),
+            let head = |v: &[f64]| v[..=500].to_vec();
+            let early = rotorid::pipeline::Record::new(
+                head(&resp.t),
+                head(&resp.x),
+                head(&resp.z),
+                Speed::Profile(s.speed),
+                0.0,
             )
             .unwrap();
-            let e = est[500];
+            let k = Knowledge::from_scenario(&s);
+            let e = identify(&early, &k, &Identification::algebraic()).unwrap();
+            let r = e.rotor.expect("every estimate determined at 0.05 s");
             let start = RotorParams {
-                m: 0.5 * (e.x.m + e.z.m),
-                cx: e.x.c,
-                kx: e.x.k,
-                cz: e.z.c,
-                kz: e.z.k,
+                m: r.m,
+                cx: r.cx,
+                kx: r.kx,
+                cz: r.cz,
+                kz: r.kz,
                 ..truth
             };
             let rec = Record::from_simulation(&s, &resp);

@@ -1,0 +1,26 @@
+//! The rotorid library against independent references (one test binary:
+//! `cargo test -p rotorid --test it`).
+
+mod identify_common;
+
+mod analysis;
+mod identify_accuracy;
+mod identify_conditioning;
+mod identify_convergence;
+mod identify_modes;
+mod identify_quadrature;
+mod identify_validation;
+mod modulating_clean;
+mod modulating_noise;
+mod pipeline;
+mod refine_clean;
+mod refine_crb;
+mod refine_identifiability;
+mod refine_inputs;
+mod refine_model;
+mod refine_noise;
+mod simulate_api;
+mod simulate_exact;
+mod simulate_newmark;
+mod simulate_noise;
+mod simulate_reference;

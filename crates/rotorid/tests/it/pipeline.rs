@@ -1,0 +1,269 @@
+//! The pipeline against the identifiers and the refinement called directly (independent
+//! paths to the same numbers), the streaming session against the batch, the time grid of
+//! rounded stamps, and its diagnostics.
+
+use rotorid::identify::algebraic::{identify_response, AlgebraicConfig, ConvergenceTracker};
+use rotorid::identify::modulating::{identify_modulating_response, ModulatingConfig};
+use rotorid::identify::Known;
+use rotorid::model::InitialState;
+use rotorid::pipeline::{
+    identify, Finding, Knowledge, Method, PipelineError, Record, Sample, Session, Speed, Timing,
+};
+use rotorid::refine::{refine, RefineOptions};
+use rotorid::test_models::{table1, table1_ramp};
+use rotorid::Parameter;
+
+#[test]
+fn algebraic_equals_the_identifier_and_its_tracker() {
+    for model in [table1(), table1_ramp(600.0).with_noise(40.0, 3)] {
+        let rec = model.record();
+        let id = identify(&rec, &model.knowledge(), &Method::algebraic()).unwrap();
+        let direct = identify_response(
+            &model.response,
+            Known::from_rotor(&model.scenario.rotor),
+            AlgebraicConfig::default(),
+        )
+        .unwrap();
+        // bit for bit (NaN at the singular first samples included)
+        let bits = |e: &[rotorid::identify::algebraic::AlgebraicEstimate]| -> Vec<u64> {
+            e.iter()
+                .flat_map(|e| {
+                    let (x, z) = (e.x, e.z);
+                    [e.t, x.m, x.c, x.k, x.rcond, z.m, z.c, z.k, z.rcond].map(f64::to_bits)
+                })
+                .collect()
+        };
+        assert!(bits(&id.estimates) == bits(&direct), "{}", model.name);
+        let mut tr = ConvergenceTracker::new(0.01, AlgebraicConfig::default().rcond_min).unwrap();
+        direct.iter().for_each(|e| tr.push(e));
+        for r in tr.results() {
+            assert_eq!(id.value(r.parameter), r.final_value, "{}", model.name);
+            let p = id.parameter(r.parameter).unwrap();
+            assert_eq!(p.identification_time_s, r.identification_time);
+        }
+    }
+}
+
+#[test]
+fn modulating_equals_the_identifier() {
+    let model = table1().with_noise(40.0, 5);
+    let id = identify(&model.record(), &model.knowledge(), &Method::modulating()).unwrap();
+    let known = Known::from_rotor(&model.scenario.rotor);
+    let e =
+        identify_modulating_response(&model.response, known, ModulatingConfig::default()).unwrap();
+    let values = e.values();
+    let std = e.std_errors();
+    for (i, p) in Parameter::PER_DIRECTION.into_iter().enumerate() {
+        let r = id.parameter(p).unwrap();
+        assert_eq!(r.value, Some(values[i]), "{p}");
+        assert_eq!(r.std_error, Some(std[i]), "{p}");
+    }
+    let noise = id.noise.unwrap();
+    assert_eq!((noise.sigma_x_m, noise.sigma_z_m), (e.sigma_x, e.sigma_z));
+}
+
+#[test]
+fn refine_from_the_same_start_equals_refine_called_directly() {
+    let model = table1().with_noise(40.0, 9);
+    let rec = model.record();
+    let id = identify(&rec, &model.knowledge(), &Method::refine()).unwrap();
+    let detail = id.refine.as_ref().unwrap();
+    let s = detail.start.values;
+    let start = rotorid::RotorParams {
+        m: s.m,
+        cx: s.cx,
+        kx: s.kx,
+        cz: s.cz,
+        kz: s.kz,
+        ..model.truth()
+    };
+    let direct = refine(
+        &rec.for_refine(),
+        &start,
+        &InitialState::default(),
+        &RefineOptions::default(),
+    )
+    .unwrap();
+    for e in &direct.parameters {
+        let p: Parameter = e.name.parse().unwrap();
+        let r = id.parameter(p).unwrap();
+        assert_eq!(r.estimate, Some(e.value), "{p}");
+        assert_eq!(r.std_error, Some(e.std_error), "{p}");
+        // within 4 standard errors of the truth, at the Cramer-Rao bound
+        let truth = r.truth.unwrap();
+        assert!((e.value - truth).abs() < 4.0 * e.std_error, "{p}");
+        let crb = r.crb.unwrap();
+        assert!(
+            (crb / e.std_error - 1.0).abs() < 0.2,
+            "{p}: crb {crb} std {}",
+            e.std_error
+        );
+    }
+    assert!(id.diagnostics.is_empty(), "{:?}", id.warnings());
+}
+
+/// Push every sample of `rec` into a session with `timing` and finish it.
+fn stream(
+    model: &rotorid::test_models::TestModel,
+    method: &Method,
+    timing: Timing,
+) -> rotorid::pipeline::Identification {
+    let r = &model.response;
+    let mut s = Session::new(&model.knowledge(), method, None, timing).unwrap();
+    let mut n = 0;
+    for i in 0..r.t.len() {
+        let sample = Sample {
+            t: Some(r.t[i]),
+            x: r.x[i],
+            z: r.z[i],
+            speed: Some(rotorid::SpeedState {
+                phi: r.phi[i],
+                omega: r.phi_dot[i],
+                omega_dot: r.phi_ddot[i],
+            }),
+        };
+        s.push(&sample, &mut |_| n += 1).unwrap();
+    }
+    let id = s.finish(&mut |_| n += 1).unwrap();
+    if matches!(method, Method::Algebraic(_)) {
+        assert_eq!(n, r.t.len(), "one estimate per sample");
+    }
+    id
+}
+
+#[test]
+fn a_session_gives_the_batch_result() {
+    let model = table1_ramp(600.0).with_noise(40.0, 11);
+    for method in [Method::algebraic(), Method::modulating(), Method::refine()] {
+        let batch = identify(&model.record(), &model.knowledge(), &method).unwrap();
+        for timing in [
+            Timing::default(),
+            Timing::Fit {
+                head: 2,
+                tolerance: 1e-6,
+            },
+        ] {
+            let streamed = stream(&model, &method, timing);
+            for p in &batch.parameters {
+                assert_eq!(
+                    streamed.parameter(p.parameter).unwrap().value,
+                    p.value,
+                    "{:?} {timing:?} {}",
+                    method.name(),
+                    p.parameter
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn rounded_stamps_give_the_true_period_and_the_same_estimates() {
+    // 25.6 kHz written with 6 decimals: the first two stamps say 3.9e-5 s (0.16 % off).
+    let mut s = rotorid::Scenario::table1();
+    s.sampling = rotorid::Sampling::new(1.0 / 25600.0, 0.5).unwrap();
+    let model = rotorid::test_models::TestModel::clean("table1@25.6kHz", s).with_noise(40.0, 2);
+    let exact = model.record();
+    let rounded: Vec<f64> = model
+        .response
+        .t
+        .iter()
+        .map(|t| (t * 1e6).round() / 1e6)
+        .collect();
+    assert!(matches!(
+        Record::new(
+            rounded.clone(),
+            model.response.x.clone(),
+            model.response.z.clone(),
+            Speed::Profile(s.speed),
+            1e-6
+        ),
+        Err(PipelineError::NonUniformSampling { .. })
+    ));
+    let rec = Record::new(
+        rounded,
+        model.response.x.clone(),
+        model.response.z.clone(),
+        Speed::Profile(s.speed),
+        0.02,
+    )
+    .unwrap();
+    let dt = 1.0 / 25600.0;
+    assert!((rec.grid().dt - dt).abs() < 1e-7 * dt, "{}", rec.grid().dt);
+    let k = Knowledge::from_scenario(&s);
+    let a = identify(&exact, &k, &Method::refine()).unwrap();
+    let b = identify(&rec, &k, &Method::refine()).unwrap();
+    for p in &a.parameters {
+        let (va, vb) = (p.value.unwrap(), b.value(p.parameter).unwrap());
+        // far below the statistical error (the old first-two-stamps dt moved k by 0.36 %)
+        assert!(
+            (va - vb).abs() < 0.05 * p.std_error.unwrap(),
+            "{}: {va} vs {vb}",
+            p.parameter
+        );
+    }
+}
+
+#[test]
+fn a_stream_whose_first_stamps_mislead_is_warned() {
+    // A grid fitted over the first 2 stamps of a record whose stamps are rounded: the
+    // period of all stamps differs, and the result says so.
+    let model = table1();
+    let r = &model.response;
+    let mut s = Session::new(
+        &model.knowledge(),
+        &Method::modulating(),
+        Some(model.scenario.speed),
+        Timing::Fit {
+            head: 2,
+            tolerance: 0.2,
+        },
+    )
+    .unwrap();
+    for i in 0..r.t.len() {
+        let t = if i == 1 { r.t[1] * 1.05 } else { r.t[i] };
+        let sample = Sample {
+            t: Some(t),
+            x: r.x[i],
+            z: r.z[i],
+            speed: None,
+        };
+        s.push(&sample, &mut |_| {}).unwrap();
+    }
+    let id = s.finish(&mut |_| {}).unwrap();
+    assert!(
+        id.diagnostics
+            .iter()
+            .any(|d| matches!(d.finding, Finding::TimeGridDrift { .. })),
+        "{:?}",
+        id.warnings()
+    );
+}
+
+#[test]
+fn too_short_records_name_what_they_need() {
+    let model = table1();
+    let r = &model.response;
+    let rec = Record::new(
+        r.t[..3].to_vec(),
+        r.x[..3].to_vec(),
+        r.z[..3].to_vec(),
+        Speed::Profile(model.scenario.speed),
+        1e-6,
+    )
+    .unwrap();
+    for method in [Method::algebraic(), Method::refine()] {
+        match identify(&rec, &model.knowledge(), &method) {
+            Err(PipelineError::TooFewSamples {
+                samples: 3,
+                needed: 4,
+                ..
+            }) => {}
+            other => panic!("{:?}: {other:?}", method.name()),
+        }
+    }
+    assert!(matches!(
+        identify(&rec, &model.knowledge(), &Method::modulating()),
+        Err(PipelineError::Modulating(_))
+    ));
+}
