@@ -1,0 +1,356 @@
+//! The options of `rotorid identify` and the method they select (each option checked
+//! against its method and its allowed range).
+
+use rotorid::identify::algebraic::Quadrature;
+use rotorid::identify::modulating::ModulatingConfig;
+use rotorid::pipeline::{AlgebraicSettings, Method, ModulatingSettings, RefineSettings};
+use rotorid::refine::Unknowns;
+
+// The defaults shown in `--help`, each written once (a test keeps them equal to the
+// library's constants): the algebraic identifier's calibrated
+// `rotorid::identify::algebraic::DEFAULT_ALGEBRAIC_RCOND_MIN`, the modulating identifier's
+// `modulating::DEFAULT_MODULATING_RCOND_MIN` and `DEFAULT_WINDOW_S`, `rotorid::identify::algebraic::DEFAULT_TOLERANCE`,
+// `Quadrature::default()` and `crate::io::DEFAULT_TIME_TOLERANCE`.
+macro_rules! rcond_min_text {
+    () => {
+        "1e-5"
+    };
+}
+macro_rules! modulating_rcond_min_text {
+    () => {
+        "1e-8"
+    };
+}
+macro_rules! tol_text {
+    () => {
+        "0.01"
+    };
+}
+macro_rules! window_text {
+    () => {
+        "0.02"
+    };
+}
+macro_rules! quadrature_text {
+    () => {
+        "am5"
+    };
+}
+#[cfg(test)]
+const RCOND_MIN_TEXT: &str = rcond_min_text!();
+#[cfg(test)]
+const MODULATING_RCOND_MIN_TEXT: &str = modulating_rcond_min_text!();
+#[cfg(test)]
+const TOL_TEXT: &str = tol_text!();
+#[cfg(test)]
+const WINDOW_TEXT: &str = window_text!();
+#[cfg(test)]
+const QUADRATURE_TEXT: &str = quadrature_text!();
+const TIME_TOLERANCE_TEXT: &str = "1e-6";
+
+/// Arguments of `rotorid identify`.
+#[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Examples:\n  rotorid simulate --scenario table1 --out - | rotorid identify - \
+                  --scenario table1 --out estimates.csv --summary summary.json\n  \
+                  rotorid identify measured.csv --scenario rig.toml --method refine --out -",
+    after_long_help = concat!(
+        "Input: CSV whose header names at least t,x,z; any column order; extra columns ignored;\n",
+        "a unit suffix is allowed and ignored (`x [m]`, `t (s)`); values in SI:\n",
+        "  t [s]                 strictly increasing, uniformly sampled (see --time-tolerance)\n",
+        "  x, z [m]              disk displacement, horizontal and vertical\n",
+        "  phi [rad], phi_dot [rad/s], phi_ddot [rad/s^2]\n",
+        "                        optional, all three or none; without them the scenario's\n",
+        "                        [speed] profile gives angle, speed and acceleration at each t\n",
+        "\n",
+        "Methods:\n",
+        "  algebraic   the paper's identifier: one estimate per sample, streaming in bounded\n",
+        "              memory (a live pipe sees each estimate as soon as its sample arrived).\n",
+        "              Accurate on clean data; under noise its estimate drifts after ~0.1 s.\n",
+        "  modulating  least squares over sliding windows of modulating-function equations,\n",
+        "              noise-bias compensated (noise sigma from 4th differences); reads the\n",
+        "              input in bounded memory and writes ONE row, at the last sample's time.\n",
+        "              Needs at least one window (--window) of data.\n",
+        "  refine      maximum-likelihood (output-error) fit of the model to the whole record,\n",
+        "              with standard errors, the Cramer-Rao bound and identifiability warnings.\n",
+        "              Batch: holds the whole record in memory (O(samples): ~60 bytes per\n",
+        "              sample at constant speed, ~250 with a variable speed) and writes ONE\n",
+        "              row, at the last sample's time.\n",
+        "              Start: the modulating estimate (m = mean of m_x and m_z); if the record\n",
+        "              is shorter than one window or that estimate is unusable, the algebraic\n",
+        "              estimate at t_first + 0.05 s (or its last well-conditioned instant\n",
+        "              before); if neither is physical (m, kx, kz > 0), the scenario's m, cx,\n",
+        "              kx, cz, kz when it states them, else an error. The summary's `start`\n",
+        "              says which, and why.\n",
+        "              Unknowns (--unknowns): m, cx, kx, cz, kz by default, plus a and/or\n",
+        "              `unbalance` (m_u d and alpha); the initial state x0, z0, vx0, vz0 (at the\n",
+        "              first sample) is always estimated. Known quantities come from the\n",
+        "              scenario (which must then state them); a and the unbalance, when unknown,\n",
+        "              start from the scenario's values.\n",
+        "              Speed: the CSV's phi columns (interpolated per sample; when they describe\n",
+        "              an exactly constant speed, that constant profile, fitted with the exact\n",
+        "              discretisation) or the scenario's profile.\n",
+        "              A record that cannot determine the unknowns is reported, not refused:\n",
+        "              `warning:` lines on stderr, `identifiable: false` and huge or null\n",
+        "              (infinite) standard errors in the summary, exit code 0.\n",
+        "\n",
+        "Output: CSV with the header t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z:\n",
+        "  t [s]                 the input's time (batch methods: the last sample's)\n",
+        "  m_x, m_z [kg]         mass identified from the x and from the z equation\n",
+        "                        (refine: the single fitted m in both)\n",
+        "  c_x, c_z [N s/m]      support damping\n",
+        "  k_x, k_z [N/m]        support stiffness\n",
+        "  rcond_x, rcond_z [1]  algebraic: reciprocal condition number of the scaled 3x3\n",
+        "                        system; modulating: of the equilibrated normal matrix;\n",
+        "                        refine: 1 / condition number of the scaled Fisher information\n",
+        "m, c, k are left EMPTY where a direction is ill-conditioned (rcond < --rcond-min, or\n",
+        "singular as at the first three samples) and, for refine, where a parameter is not\n",
+        "determined (infinite standard error, standard error above its value, or unknowns\n",
+        "the data cannot separate) or not estimated (known, see --unknowns).\n",
+        "\n",
+        "Examples:\n",
+        "  rotorid simulate --scenario table1 --out - \\\n",
+        "    | rotorid identify - --scenario table1 --out estimates.csv --summary summary.json\n",
+        "  rotorid simulate --scenario table1 --snr-db 40 --out noisy.csv\n",
+        "  rotorid identify noisy.csv --scenario table1 --method refine --out fit.csv \\\n",
+        "    --summary fit.json\n",
+        "  rotorid identify measured.csv --scenario rig.toml --method refine \\\n",
+        "    --unknowns m,cx,kx,cz,kz,unbalance --out -"
+    )
+)]
+pub struct IdentifyArgs {
+    /// The response CSV, or `-` for stdin.
+    #[arg(value_name = "INPUT.csv|-")]
+    pub input: String,
+
+    /// The scenario: `table1` (built in) or a TOML file. Needs the known a, m_u, d,
+    /// alpha_deg; m, cx, cz, kx, kz are optional (truth, for the error report; refine:
+    /// required for the parameters --unknowns leaves known); [speed] is needed only if the
+    /// input has no phi columns.
+    #[arg(long, value_name = "table1|FILE.toml")]
+    pub scenario: String,
+
+    /// Identification method (see the long help, `--help`). modulating and refine write one
+    /// row at the end; refine holds the whole record in memory (O(samples)).
+    #[arg(long, value_enum, default_value_t = IdentifyMethod::Algebraic)]
+    pub method: IdentifyMethod,
+
+    /// refine only: the quantities to estimate, comma-separated, from m, cx, kx, cz, kz, a,
+    /// unbalance (m_u d and alpha) [default: m,cx,kx,cz,kz]. The initial state is always
+    /// estimated; the others are known (from the scenario).
+    #[arg(long, value_enum, value_name = "NAMES", value_delimiter = ',')]
+    pub unknowns: Option<Vec<UnknownName>>,
+
+    #[arg(long, value_name = "RULE", help = concat!(
+        "Running quadrature of the algebraic identifier's iterated integrals: trapezoid ",
+        "(order 2, as the paper), am3, am4, am5 (Adams-Moulton, order 3-5) [default: ",
+        quadrature_text!(), "]. algebraic, and refine's algebraic fallback start"))]
+    pub quadrature: Option<Quadrature>,
+
+    /// algebraic only: write every N-th estimate (the 1st, (N+1)-th, ...); all are computed
+    /// and tracked [default: 1].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub every: Option<u64>,
+
+    #[arg(long, value_name = "REL", allow_hyphen_values = true, help = concat!(
+        "algebraic only: relative band defining the identification time: the earliest t ",
+        "after which every well-conditioned estimate stays within tol of its final value ",
+        "[default: ", tol_text!(), "]"))]
+    pub tol: Option<f64>,
+
+    #[arg(long, value_name = "R", allow_hyphen_values = true, help = concat!(
+        "Estimates whose reciprocal condition number is below this are flagged as ",
+        "ill-conditioned (not written, never counted as converged) [default: ",
+        rcond_min_text!(), " for algebraic (scaled 3x3 system), ", modulating_rcond_min_text!(),
+        " for modulating (equilibrated normal matrix)]. refine: applies to the identifier ",
+        "that gives its start"))]
+    pub rcond_min: Option<f64>,
+
+    #[arg(long, value_name = "S", allow_hyphen_values = true, help = concat!(
+        "modulating and refine: window length of the modulating-function identifier [s] ",
+        "(windows overlap: the hop is a fixed fraction of it, reported as modulating.hop_s in the summary) [default: ", window_text!(),
+        "]"))]
+    pub window: Option<f64>,
+
+    /// Allowed deviation of each time step from dt = t_2 - t_1, relative to dt.
+    #[arg(long, value_name = "REL", default_value = TIME_TOLERANCE_TEXT, allow_hyphen_values = true)]
+    pub time_tolerance: f64,
+
+    /// The estimates CSV, or `-` for stdout. Written as it goes (a file can be followed
+    /// while it grows); after an error it holds the whole rows written before it.
+    #[arg(long, short, value_name = "ESTIMATES.csv|-")]
+    pub out: String,
+
+    /// Also write a JSON summary: final values, identification times, truth and relative
+    /// errors, flagged counts; for modulating and refine also noise levels, standard
+    /// errors, Cramer-Rao bounds, warnings (see the documentation of the summary format).
+    #[arg(long, value_name = "SUMMARY.json")]
+    pub summary: Option<String>,
+
+    /// Do not print the summary on stderr (warnings are still printed).
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// `--method` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum IdentifyMethod {
+    /// The paper's algebraic identifier (3x3 system per direction per sample), streaming.
+    Algebraic,
+    /// Modulating-function least squares over windows, noise-bias compensated; one row.
+    Modulating,
+    /// Maximum-likelihood output-error fit with standard errors and Cramer-Rao bounds;
+    /// batch (memory O(samples)); one row.
+    Refine,
+}
+
+impl IdentifyMethod {
+    /// The name written in the summary.
+    pub fn name(self) -> &'static str {
+        match self {
+            IdentifyMethod::Algebraic => "algebraic",
+            IdentifyMethod::Modulating => "modulating",
+            IdentifyMethod::Refine => "refine",
+        }
+    }
+}
+
+/// `--unknowns` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum UnknownName {
+    /// Mass m [kg].
+    M,
+    /// Damping cx [N s/m].
+    Cx,
+    /// Stiffness kx [N/m].
+    Kx,
+    /// Damping cz [N s/m].
+    Cz,
+    /// Stiffness kz [N/m].
+    Kz,
+    /// Gyroscopic coefficient a [N s^2/m].
+    A,
+    /// Unbalance m_u d [kg m] and its angle alpha [rad].
+    Unbalance,
+}
+
+/// The method and its settings from the options (each option checked against its method
+/// and its range).
+pub(super) fn method_of(args: &IdentifyArgs) -> anyhow::Result<Method> {
+    let ok = |v: f64| v.is_finite() && v >= 0.0;
+    let method = args.method;
+    let only = |flag: &str, given: bool, allowed: &[IdentifyMethod]| -> anyhow::Result<()> {
+        if given && !allowed.contains(&method) {
+            let names: Vec<&str> = allowed.iter().map(|m| m.name()).collect();
+            anyhow::bail!(
+                "{flag} applies to --method {} only, not to --method {}",
+                names.join(" and "),
+                method.name()
+            );
+        }
+        Ok(())
+    };
+    use IdentifyMethod::{Algebraic, Modulating, Refine};
+    only("--every", args.every.is_some(), &[Algebraic])?;
+    only("--tol", args.tol.is_some(), &[Algebraic])?;
+    only(
+        "--quadrature",
+        args.quadrature.is_some(),
+        &[Algebraic, Refine],
+    )?;
+    only("--window", args.window.is_some(), &[Modulating, Refine])?;
+    only("--unknowns", args.unknowns.is_some(), &[Refine])?;
+    let mut algebraic = AlgebraicSettings {
+        quadrature: args.quadrature.unwrap_or_default(),
+        ..AlgebraicSettings::default()
+    };
+    if let Some(tol) = args.tol {
+        if !ok(tol) {
+            anyhow::bail!("--tol = {tol} is out of range: must be finite and >= 0 (relative)");
+        }
+        algebraic.tol = tol;
+    }
+    let window_s = args
+        .window
+        .unwrap_or(rotorid::identify::modulating::DEFAULT_WINDOW_S);
+    if !(window_s.is_finite() && window_s > 0.0) {
+        anyhow::bail!("--window = {window_s} is out of range: must be finite and > 0 (s)");
+    }
+    let mut modulating = ModulatingSettings {
+        config: ModulatingConfig::with_window(window_s),
+    };
+    if let Some(r) = args.rcond_min {
+        if !(ok(r) && r <= 1.0) {
+            anyhow::bail!("--rcond-min = {r} is out of range: must be in [0, 1]");
+        }
+        algebraic.rcond_min = r;
+        modulating.config.rcond_min = r;
+    }
+    if !ok(args.time_tolerance) {
+        anyhow::bail!(
+            "--time-tolerance = {} is out of range: must be finite and >= 0 (relative to dt)",
+            args.time_tolerance
+        );
+    }
+    Ok(match method {
+        Algebraic => Method::Algebraic(algebraic),
+        Modulating => Method::Modulating(modulating),
+        Refine => Method::Refine(RefineSettings {
+            unknowns: unknowns_of(args.unknowns.as_deref()),
+            algebraic,
+            modulating,
+            ..RefineSettings::default()
+        }),
+    })
+}
+
+/// The unknowns `--unknowns` selects (default m, cx, kx, cz, kz); the initial state is
+/// always estimated.
+fn unknowns_of(names: Option<&[UnknownName]>) -> Unknowns {
+    let Some(names) = names else {
+        return Unknowns::default();
+    };
+    let has = |n: UnknownName| names.contains(&n);
+    Unknowns {
+        m: has(UnknownName::M),
+        cx: has(UnknownName::Cx),
+        kx: has(UnknownName::Kx),
+        cz: has(UnknownName::Cz),
+        kz: has(UnknownName::Kz),
+        a: has(UnknownName::A),
+        unbalance: has(UnknownName::Unbalance),
+        initial_state: true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rotorid::pipeline::DEFAULT_TIME_TOLERANCE;
+
+    #[test]
+    fn help_defaults_are_the_library_defaults() {
+        use rotorid::identify::modulating;
+        assert_eq!(
+            RCOND_MIN_TEXT.parse::<f64>().unwrap(),
+            rotorid::identify::algebraic::DEFAULT_ALGEBRAIC_RCOND_MIN
+        );
+        assert_eq!(
+            MODULATING_RCOND_MIN_TEXT.parse::<f64>().unwrap(),
+            modulating::DEFAULT_MODULATING_RCOND_MIN
+        );
+        assert_eq!(
+            TIME_TOLERANCE_TEXT.parse::<f64>().unwrap(),
+            DEFAULT_TIME_TOLERANCE
+        );
+        assert_eq!(
+            TOL_TEXT.parse::<f64>().unwrap(),
+            rotorid::identify::algebraic::DEFAULT_TOLERANCE
+        );
+        assert_eq!(
+            WINDOW_TEXT.parse::<f64>().unwrap(),
+            modulating::DEFAULT_WINDOW_S
+        );
+        assert_eq!(Quadrature::default().to_string(), QUADRATURE_TEXT);
+    }
+}
