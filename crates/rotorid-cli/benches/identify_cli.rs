@@ -1,7 +1,7 @@
-//! End-to-end time of `rotorid identify` on a 1,000,000-row response CSV (issue: the
-//! algebraic identifiers, item 8), for each method. The CSV is written once by
-//! `rotorid simulate` (table1, 1200 rpm, 100 s at 0.1 ms) into a temporary directory;
-//! each iteration runs the release binary as a user would, output to /dev/null.
+//! End-to-end time of `rotorid identify` on a 1,000,000-row response CSV, for each method.
+//! The CSV is written once by `rotorid simulate` (table1, 1200 rpm, 100 s at 0.1 ms) into a
+//! temporary directory; each iteration runs the release binary as a user would, output to
+//! /dev/null.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -7,7 +7,7 @@
 //! Cases: table1 at a constant 1200 rpm and on the 10 rad/s^2 ramp from 600 rpm (phi(0) = 0,
 //! zero initial state, dt = 0.1 ms, exact simulation), SNR 20, 40, 60 dB, record length
 //! T = 0.1, 0.3, 1 s; N noise seeds each (default 100). Noise per channel c in {x, z}:
-//! sigma_c = RMS(c over the record) 10^(-SNR/20) (method.md section 7, `add_noise`).
+//! sigma_c = RMS(c over the record) 10^(-SNR/20) (docs/method.md section 2.5, `add_noise`).
 //!
 //! Methods, each through `rotorid::pipeline::identify` with its defaults (a, m_u d and
 //! alpha known; m, cx, kx, cz, kz estimated):

@@ -1,14 +1,16 @@
 //! `rotorid demo`: the paper's experiment in one command. The Table 1 rotor (paper eq. 1;
-//! method.md section 1) is simulated for 1 s at dt = 0.1 ms at constant speed (1200 rpm)
-//! and on the 10 rad/s^2 ramp from rest and from 1200 rpm; the algebraic identifier
-//! (paper eqs. 7-8; method.md section 5) estimates m, c, k of both directions at every
-//! sample; per parameter we print the true value, the final estimate, its relative error
-//! and the identification time (earliest t after which every well-conditioned estimate stays
-//! within 1 % of the final value), beside the time the paper reports (Barredo et al. 2024,
-//! sections 4.1-4.2: constant speed < 0.2 s; variable speed m, k < 0.1 s, c < 0.28 s).
+//! docs/method.md section 1) is simulated for 1 s at dt = 0.1 ms at constant speed (1200
+//! rpm) and on the 10 rad/s^2 ramp from rest and from 1200 rpm; the algebraic identifier
+//! (paper eqs. 7-8; docs/method.md section 3.4) estimates m, c, k of both directions at
+//! every sample; per parameter we print the true value, the final estimate, its relative
+//! error and the identification time (earliest t after which every well-conditioned
+//! estimate stays within 1 % of the final value), beside the time the paper reports
+//! (Barredo et al. 2024, sections 4.1-4.2: constant speed < 0.2 s; variable speed m, k <
+//! 0.1 s, c < 0.28 s).
 //!
 //! Two settings: ours (exact simulation, default quadrature) and the paper's (Newmark
-//! data, trapezoid rule), so the reader sees what each choice costs (method.md section 6).
+//! data, trapezoid rule), so the reader sees what each choice costs
+//! (docs/method.md section 3.8).
 
 use std::fmt::Write as _;
 

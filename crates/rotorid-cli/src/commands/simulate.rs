@@ -11,7 +11,7 @@
 //! Without noise, rows are streamed straight from the integrator's step loop (memory does
 //! not grow with the record). With `--snr-db` the whole record is held in memory
 //! (6 x 8 bytes per sample), because the noise level is relative to each channel's RMS
-//! over the whole record (`rotorid::simulate::add_noise`, method.md section 7).
+//! over the whole record (`rotorid::simulate::add_noise`, docs/method.md section 2.5).
 //! A file output appears only once complete (temporary file + rename).
 
 use anyhow::Context as _;

@@ -1,6 +1,6 @@
 //! The estimates CSV written by `rotorid identify`: the algebraic identifier's estimate of
-//! theta = (m, c, k) per direction at each (or every N-th) sample (method.md section 5,
-//! `A(t) theta = b(t)`).
+//! theta = (m, c, k) per direction at each (or every N-th) sample
+//! (docs/method.md section 3.4, `A(t) theta = b(t)`).
 //!
 //! ```text
 //! t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z

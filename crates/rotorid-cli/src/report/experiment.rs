@@ -3,13 +3,14 @@
 //!
 //! Cases (table1 rotor, paper Table 1; dt = 0.1 ms):
 //! - constant speed, 1200 rpm, phi(0) = 0 (paper figs. 2-5; identifier eqs. 2-8, the
-//!   constant-speed form of method.md section 4);
+//!   constant-speed form of docs/method.md section 3.3);
 //! - linear ramp w(t) = w0 + 10 t rad/s from rest, w0 = 0 (paper figs. 6-9; the paper does
-//!   not state w0; general identifier of method.md section 4).
+//!   not state w0; general identifier of docs/method.md section 3.3).
 //!
 //! Settings:
 //! - "paper": response by average-acceleration Newmark, iterated integrals by the
-//!   cumulative trapezoid rule (what the paper's transients point to, method.md section 6);
+//!   cumulative trapezoid rule (what the paper's transients point to,
+//!   docs/method.md section 3.5);
 //! - "ours": response by exact discretisation (constant speed) or DOP853 at tight
 //!   tolerance (ramp), integrals by the identifier's default (5th-order Adams-Moulton);
 //! - and, to attribute the paper's error to its data or to its rule, the two cross

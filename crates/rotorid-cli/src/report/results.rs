@@ -10,9 +10,9 @@
 //! with tol = 1 %. T measures convergence to the TRUE value (the paper's "tiempo de
 //! identificación"); `settling_time` is the identifier's own answer without the truth
 //! ([`rotorid::identify::algebraic::ConvergenceTracker`]: within 1 % of its final value). Instants
-//! with rcond < rcond_min are not estimates and are skipped by both (method.md section 6).
-//! Paper's claims (Barredo et al. 2024, "Resultados"): constant speed, all parameters in
-//! < 0.2 s; ramp, m and k in < 0.1 s and c in < 0.28 s.
+//! with rcond < rcond_min are not estimates and are skipped by both
+//! (docs/method.md section 3.6). Paper's claims (Barredo et al. 2024, "Resultados"):
+//! constant speed, all parameters in < 0.2 s; ramp, m and k in < 0.1 s and c in < 0.28 s.
 
 use rotorid::identify::algebraic::ConvergenceTracker;
 use rotorid::Parameter;

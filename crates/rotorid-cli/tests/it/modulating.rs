@@ -1,8 +1,8 @@
 //! End-to-end tests of `rotorid identify --method modulating`: on noisy data it recovers
 //! the paper's rotor where the algebraic identifier's final estimate has drifted away
-//! (method.md section 6), with one estimates row and the noise level, window figures and
-//! standard errors in the summary; a record without excitation withholds both directions
-//! with a warning; flags of other methods and too-short records are refused.
+//! (docs/method.md section 3.8), with one estimates row and the noise level, window figures
+//! and standard errors in the summary; a record without excitation withholds both
+//! directions with a warning; flags of other methods and too-short records are refused.
 
 use std::sync::OnceLock;
 

@@ -1,12 +1,12 @@
-//! What the identifier is given: the known quantities of the model (method.md section 4:
-//! a, m_u d, alpha) and one measurement per sampling instant.
+//! What the identifier is given: the known quantities of the model
+//! (docs/method.md section 3.3: a, m_u d, alpha) and one measurement per sampling instant.
 
 use serde::{Deserialize, Serialize};
 
 use super::error::InputError;
 use crate::model::{check, Rotor, SpeedState};
 
-/// The quantities the identifiers take as known (method.md section 4).
+/// The quantities the identifiers take as known (docs/method.md section 3.3).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Known {
     /// Gyroscopic coefficient a \[N s^2/m\], any finite value.

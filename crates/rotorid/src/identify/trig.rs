@@ -12,8 +12,8 @@
 //! (`e_rem_pio2.c`, `k_sin.c`, `k_cos.c`, Sun Microsystems 1993; also in musl and Go).
 //! For |x| <= 1.6e6 rad (< 2^20 pi/2; 3.5 h at 1200 rpm) k P1 is exact and the result is
 //! within ~1 ulp of 1 (absolute error <= 2.5e-16; checked against `f64::sin_cos` in the
-//! tests); beyond that, and for non-finite x, it is `f64::sin_cos`. About twice as fast as
-//! the C library's `sincos` and branch-free in the common case.
+//! tests); beyond that, and for non-finite x, it is `f64::sin_cos`. Faster than the C
+//! library's `sincos` (docs/performance.md) and branch-free in the common case.
 
 /// 2/pi
 const INV_PIO2: f64 = f64::from_bits(0x3FE4_5F30_6DC9_C883);

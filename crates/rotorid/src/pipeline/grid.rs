@@ -1,6 +1,6 @@
 //! The time grid of a record: t_i = t0 + i dt, fitted by least squares over every time
-//! stamp (docs/method.md section 6), so stamps printed with few decimals (25.6 kHz written
-//! to 6 decimals) give the true period, not the difference of the first two.
+//! stamp (docs/method.md section 6.2), so stamps printed with few decimals (25.6 kHz
+//! written to 6 decimals) give the true period, not the difference of the first two.
 //!
 //! With u_i = t_i - t_first and i = 0 .. n-1,
 //!

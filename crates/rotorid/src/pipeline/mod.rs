@@ -1,7 +1,7 @@
 //! The identification pipeline every caller uses (the `rotorid` command, the Python
 //! package, the fleet worker): a [`Record`], what is [`Knowledge`] besides it, and a
 //! [`Method`] give one [`Identification`] with its [`Diagnostic`]s; a [`Session`] does the
-//! same for samples that arrive as a stream. docs/method.md explains each step.
+//! same for samples that arrive as a stream. docs/method.md section 6 explains each step.
 //!
 //! ```
 //! use rotorid::pipeline::{identify, Knowledge, Method, Record};

@@ -3,12 +3,13 @@
 //! For white Gaussian noise sigma_x on x and sigma_z on z the Fisher information of the
 //! unknowns theta is F = J_x^T J_x / sigma_x^2 + J_z^T J_z / sigma_z^2 with J the exact
 //! sensitivities of the discrete model at the true parameters, and every unbiased
-//! estimator has Cov(theta_hat) >= F^-1 (Kay 1993, ch. 3; method.md section 7). With the
-//! initial state unknown its four components are nuisance parameters and the bound on the
-//! rest is the corresponding block of F^-1 (which is larger than with the state known).
+//! estimator has Cov(theta_hat) >= F^-1 (Kay 1993, ch. 3; docs/method.md section 5.1.5).
+//! With the initial state unknown its four components are nuisance parameters and the bound
+//! on the rest is the corresponding block of F^-1 (which is larger than with the state
+//! known).
 //!
-//! method.md section 7 defines the noise by the signal-to-noise ratio of each channel:
-//! sigma = RMS(clean channel) * 10^(-SNR/20), RMS over all samples of the record.
+//! docs/method.md section 2.5 defines the noise by the signal-to-noise ratio of each
+//! channel: sigma = RMS(clean channel) * 10^(-SNR/20), RMS over all samples of the record.
 
 use crate::model::{check, InitialState, RotorParams, Scenario};
 
@@ -87,7 +88,8 @@ fn rms(v: &[f64]) -> f64 {
 }
 
 /// The Cramer-Rao bound for a simulated scenario at a signal-to-noise ratio `snr_db`
-/// \[dB\] per channel: sigma = RMS(clean channel) * 10^(-SNR/20) (method.md section 7).
+/// \[dB\] per channel: sigma = RMS(clean channel) * 10^(-SNR/20)
+/// (docs/method.md section 2.5).
 pub fn crb_at_snr(
     scenario: &Scenario,
     snr_db: f64,

@@ -1,4 +1,5 @@
-//! Exact discretisation at constant speed W (method.md section 6; Van Loan 1978).
+//! Exact discretisation at constant speed W (docs/method.md sections 2.2 and 5.1.3; Van
+//! Loan 1978).
 //!
 //! With the forcing oscillator (s, c) = (sin phi, cos phi), phi = phi0 + W t, appended to
 //! the state, eq. (1) at w' = 0 is the autonomous linear system Y' = A Y,

@@ -14,7 +14,7 @@
 //! state as four nuisance parameters; optionally a and the unbalance), by Gauss-Newton
 //! with Levenberg-Marquardt damping on the exact sensitivities of the discrete model.
 //! Standard errors come from the Fisher information at the estimate; [`crb()`] gives the
-//! Cramer-Rao bound at the truth (method.md section 7).
+//! Cramer-Rao bound at the truth (docs/method.md sections 5.1.5 and 5.4).
 //!
 //! The model must be far more accurate than the noise (the relative bound on m is ~4e-5
 //! at 40 dB): at constant speed it is discretised exactly (matrix exponential of the state

@@ -1,4 +1,4 @@
-//! Time-domain simulation of the rotor of paper eq. (1) (method.md section 1):
+//! Time-domain simulation of the rotor of paper eq. (1) (docs/method.md sections 1 and 2):
 //!
 //! ```text
 //! m x'' + cx x' - a w z' - a w' z + kx x = mud ( w^2 sin(phi+alpha) - w' cos(phi+alpha) )

@@ -29,8 +29,8 @@
 //!
 //! The phase sin(phi + alpha), cos(phi + alpha) of the unbalance force comes from a
 //! rotation recurrence re-synchronised exactly every 64 steps (see `phase.rs`: within
-//! 2e-14 + 4 eps |phi| of the exact phase, i.e. < 3.1e-14 for 1 s at 1200 rpm, and ~20 ns
-//! per step cheaper than `sin_cos`).
+//! 2e-14 + 4 eps |phi| of the exact phase, i.e. < 3.1e-14 for 1 s at 1200 rpm, and
+//! cheaper than `sin_cos`: docs/performance.md).
 
 use nalgebra::Vector2;
 

@@ -1,5 +1,5 @@
 //! Additive white Gaussian measurement noise at a given signal-to-noise ratio
-//! (method.md section 7). Per channel c in {x, z}:
+//! (docs/method.md section 2.5). Per channel c in {x, z}:
 //!
 //! ```text
 //! sigma_c = RMS(c) * 10^(-SNR/20),   RMS(c) = sqrt( (1/N) sum_i c_i^2 )   (whole record, not std)

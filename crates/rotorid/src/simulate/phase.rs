@@ -19,8 +19,8 @@
 //! any f64 evaluation of phi(t) carries anyway (a direct `sin_cos(phi(t_n) + alpha)` is off
 //! by up to ~1.5 eps |phi|). For 1 s of table1 at 1200 rpm (|phi| < 130 rad) that is
 //! < 3.1e-14 measured (direct: 1.3e-14); both are far below the 1e-13 budget and
-//! Newmark's own ~1e-4 error. A direct `sin_cos` costs ~25 ns, a rotation ~3 ns: the
-//! recurrence takes Newmark at constant speed from ~36 to ~18 ns per step.
+//! Newmark's own ~1e-4 error. A rotation is much cheaper than a direct `sin_cos`
+//! (timings: docs/performance.md).
 
 use crate::model::SpeedProfile;
 

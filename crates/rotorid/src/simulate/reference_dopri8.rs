@@ -3,7 +3,7 @@
 //! *Solving Ordinary Differential Equations I*, 2nd ed., Springer, 1993, ch. II), as
 //! implemented by `russell_ode` (`Method::DoPri8`), at tight tolerance.
 //!
-//! Eq. (1) (method.md section 1) as a first-order system, q = (x, z):
+//! Eq. (1) (docs/method.md section 1.2) as a first-order system, q = (x, z):
 //!
 //! ```text
 //! q'  = v
@@ -26,16 +26,16 @@
 //! amplitude):
 //!
 //! ```text
-//! interval by interval, tol 1e-13:  7.7e-14   (1 step per interval, ~2 us per sample)
+//! interval by interval, tol 1e-13:  7.7e-14   (1 step per interval)
 //! dense output,         tol 1e-13:  6.3e-11   (1665 steps in all)
 //! dense output,         tol 1e-14:  1.1e-11   (2220 steps)
 //! ```
 //!
-//! The dense route is ~5x cheaper but ~1000x less accurate, because at the paper's 0.1 ms
-//! the interval caps the step well below what the tolerance allows; we keep accuracy.
-//! When the sampling interval is long enough for the tolerance to set the step, the global
-//! error is about 100 tol (test `simulate_reference.rs`: 1.0e-11 at tol 1e-13 on a 10 ms
-//! grid); with 1 ms sampling it was 4.1e-12.
+//! The dense route is cheaper (docs/performance.md) but ~1000x less accurate, because at
+//! the paper's 0.1 ms the interval caps the step well below what the tolerance allows; we
+//! keep accuracy. When the sampling interval is long enough for the tolerance to set the
+//! step, the global error is about 100 tol (test `simulate_reference.rs`: 1.0e-11 at tol
+//! 1e-13 on a 10 ms grid); with 1 ms sampling it was 4.1e-12.
 
 use russell_lab::Vector;
 use russell_ode::{Method as RussellMethod, NoArgs, OdeSolver, Params, System};

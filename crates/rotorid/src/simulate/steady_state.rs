@@ -1,6 +1,6 @@
 //! Closed-form steady-state response at constant speed W (the oracle the integrators are
 //! tested against). With th = W t + phi0 + alpha and w' = 0, the unbalance force of eq. (1)
-//! (method.md section 1) is
+//! (docs/method.md section 1.2) is
 //!
 //! ```text
 //! F(t) = Re( F^ e^{i th} ),   F^ = mud W^2 (-i, 1)        (x: sin th, z: cos th)

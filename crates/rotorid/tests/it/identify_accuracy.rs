@@ -1,5 +1,5 @@
-//! Accuracy of the algebraic identifier on exact data (method.md "Checked numbers"; the
-//! issue's targets): table1 at dt = 0.1 ms, 1200 rpm and the 10 rad/s^2 ramps from rest
+//! Accuracy of the algebraic identifier on exact data (docs/method.md section 3.8):
+//! table1 at dt = 0.1 ms, 1200 rpm and the 10 rad/s^2 ramps from rest
 //! and from 1200 rpm, with zero and with non-zero initial conditions.
 
 use crate::identify_common::*;

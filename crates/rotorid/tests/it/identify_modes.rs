@@ -1,6 +1,6 @@
-//! The constant-speed identifier (method.md section 4, constant case) against the general
-//! one and against an independent, slow, whole-array implementation of its formulas; batch
-//! against streaming.
+//! The constant-speed identifier (docs/method.md section 3.3, constant speed) against the
+//! general one and against an independent, slow, whole-array implementation of its
+//! formulas; batch against streaming.
 
 use crate::identify_common::*;
 use nalgebra::{Matrix3, Vector3};
@@ -75,8 +75,8 @@ fn lin(terms: &[(f64, &[f64])]) -> Vec<f64> {
         .collect()
 }
 
-/// The constant-speed identifier written directly from method.md sections 3-5 (slow,
-/// whole arrays, nalgebra LU): estimates (m, c, k) for one direction at sample `n`.
+/// The constant-speed identifier written directly from docs/method.md sections 3.1-3.4
+/// (slow, whole arrays, nalgebra LU): estimates (m, c, k) for one direction at sample `n`.
 struct Reference {
     a: [Vec<f64>; 9],
     b: [Vec<f64>; 3],

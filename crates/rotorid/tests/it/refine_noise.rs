@@ -96,7 +96,7 @@ fn ramp_rms_error_within_twice_the_bound() {
     }
 }
 
-/// The targets with 100 seeds: RMS <= 1.5 CRB, |bias| <= 0.3 CRB, coverage 90-99 %.
+/// Efficiency with 100 seeds: RMS <= 1.5 CRB, |bias| <= 0.3 CRB, coverage 90-99 %.
 /// Run with `cargo test --release -p rotorid --test refine_noise -- --ignored --nocapture`.
 #[test]
 #[ignore]

@@ -1,5 +1,5 @@
 //! Accuracy of the exact reference (`Method::Exact`) against closed forms and against each
-//! other (task items (a) and (d)):
+//! other:
 //! - started on the closed-form steady state, the exact discretisation stays on it;
 //! - the DoPri8 path forced onto a constant-speed profile agrees with the exact
 //!   discretisation (two independent methods);

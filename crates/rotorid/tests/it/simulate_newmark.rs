@@ -1,5 +1,5 @@
-//! The paper's Newmark integrator converges at order 2 to the exact reference (task item
-//! (b)): halving dt divides the error by 4, at constant speed and on a ramp.
+//! The paper's Newmark integrator converges at order 2 to the exact reference: halving dt
+//! divides the error by 4, at constant speed and on a ramp.
 
 use rotorid::model::{Sampling, Scenario};
 use rotorid::simulate::{simulate, Method, TimeResponse};

@@ -1,4 +1,4 @@
-//! The DoPri8 reference on ramps (task item (c)): it converges as the tolerance tightens,
+//! The DoPri8 reference on ramps: it converges as the tolerance tightens,
 //! and it agrees with an independent second method, a fixed-step classical Runge-Kutta 4
 //! with Richardson extrapolation written here from eq. (1) directly.
 

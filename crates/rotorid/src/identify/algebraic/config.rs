@@ -1,6 +1,7 @@
 //! Configuration of the algebraic identifier: the running quadrature, the conditioning
-//! threshold below which an instant is flagged, and the speed model (method.md section 4:
-//! the general, variable-speed identifier or its constant-speed special case).
+//! threshold below which an instant is flagged, and the speed model
+//! (docs/method.md section 3.3: the general, variable-speed identifier or its
+//! constant-speed special case).
 
 use serde::{Deserialize, Serialize};
 
@@ -26,11 +27,12 @@ pub const DEFAULT_ALGEBRAIC_RCOND_MIN: f64 = 1e-5;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub enum SpeedModel {
     /// Variable speed: phi, w = phi', w' = phi'' are taken from every measurement
-    /// (method.md section 4, general case).
+    /// (docs/method.md section 3.3, general case).
     #[default]
     General,
     /// Constant speed W: w = W, w' = 0 and phi = phi0 + W t (t the measurement's time);
-    /// the measurements' speed fields are ignored (method.md section 4, constant case).
+    /// the measurements' speed fields are ignored (docs/method.md section 3.3, constant
+    /// case).
     Constant {
         /// Speed W \[rad/s\], finite.
         omega: f64,

@@ -1,5 +1,5 @@
-//! The identifier's output at one instant: theta = (m, c, k) per direction (method.md
-//! section 5) and the conditioning of the 3x3 system it came from ([`super::system`]).
+//! The identifier's output at one instant: theta = (m, c, k) per direction (docs/method.md
+//! section 3.4) and the conditioning of the 3x3 system it came from ([`super::system`]).
 
 use serde::{Deserialize, Serialize};
 

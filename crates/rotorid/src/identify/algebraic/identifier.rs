@@ -1,5 +1,5 @@
-//! The algebraic identifier of m, c, k per direction (paper eqs. 7-8, method.md sections
-//! 3-5), streaming: one estimate per sample, O(1) work, no allocation.
+//! The algebraic identifier of m, c, k per direction (paper eqs. 7-8, docs/method.md
+//! sections 3.1-3.4), streaming: one estimate per sample, O(1) work, no allocation.
 //!
 //! With tau = t - t_0 (t_0 the identifier's first sample) and the iterated integrals
 //! In from t_0 ([`super::quadrature`]):
@@ -37,10 +37,10 @@
 //! b = [ I1[u] + I2[v];  I2[u] + I3[v];  I3[u] + I4[v] ]
 //! ```
 //!
-//! The constant-speed identifier (method.md section 4, constant case) is the same engine
-//! with w = W, w' = 0 and phi = phi0 + W t ([`SpeedModel::Constant`]); with w' = 0 the w'
-//! terms vanish and the formulas reduce to
-//! `Sx = a W (I1[tau^2 z] - 2 I2[tau z]) + mud W^2 I2[tau^2 sin(W t + phi0 + alpha)]`, etc.
+//! The constant-speed identifier (docs/method.md section 3.3, constant speed) is the same
+//! engine with w = W, w' = 0 and phi = phi0 + W t ([`SpeedModel::Constant`]); with w' = 0
+//! the w' terms vanish and the formulas reduce to `Sx = a W (I1[tau^2 z] - 2 I2[tau z]) +
+//! mud W^2 I2[tau^2 sin(W t + phi0 + alpha)]`, etc.
 //!
 //! tau is taken on the nominal grid, tau_n = n dt: the measured times are only checked to be
 //! uniform (so an absolute time base such as a Unix time does not cost precision).
@@ -48,9 +48,8 @@
 //! Accuracy (tests/identify_accuracy.rs; table1, exact data, dt = 0.1 ms, default order-5
 //! quadrature): relative error at t = 0.1 s ~1e-9 (m), ~1e-10 (k), ~1e-7 (c), with or
 //! without initial displacement and velocity; every well-conditioned estimate within
-//! 6e-4 from t = 20 ms on. Speed (benches/identify.rs): one estimate of both directions
-//! costs ~70 ns (~15 million samples/s on one core of an AMD EPYC); on x86_64 the hot path
-//! is compiled for AVX2 when the CPU has it, with bit-for-bit the same results.
+//! 6e-4 from t = 20 ms on. On x86_64 the hot path is compiled for AVX2 when the CPU has
+//! it, with bit-for-bit the same results (timings: docs/performance.md).
 
 use super::config::{AlgebraicConfig, SpeedModel};
 use super::error::AlgebraicError;

@@ -1,4 +1,5 @@
-//! Running (cumulative) quadrature for the iterated integrals of method.md section 2:
+//! Running (cumulative) quadrature for the iterated integrals of docs/method.md section 3.1
+//! (the rules: section 3.5):
 //!
 //! ```text
 //! I1[f](t_n) = integral_{t_0}^{t_n} f,      Ik[f] = I1[I(k-1)[f]],   k = 1..4

@@ -1,5 +1,5 @@
-//! The 3x3 system of the paper's eqs. (7)-(8) (method.md section 5), scaled and solved at
-//! one instant, with its conditioning:
+//! The 3x3 system of the paper's eqs. (7)-(8) (docs/method.md sections 3.4 and 3.6), scaled
+//! and solved at one instant, with its conditioning:
 //!
 //! ```text
 //! A theta = b,    A = [p; I1[p]; I2[p]],  b = [s; I1[s]; I2[s]],  theta = (m, c, k)

@@ -1,16 +1,16 @@
 //! Noise-robust identification of m, c, k per direction by modulating functions and least
-//! squares over many windows (method.md section 6: a robust variant of the paper's
+//! squares over many windows (docs/method.md section 4: a robust variant of the paper's
 //! algebraic identifier).
 //!
 //! The algebraic identifier (Barredo et al. 2024; [`super::AlgebraicIdentifier`]) is a
 //! modulating-function method whose kernel tau^2 = (t - t_0)^2 vanishes only at t_0: its
 //! P\[y\] holds the raw sample tau^2 y(t) and the weights tau^n grow with time, so under
-//! noise it drifts (method.md section 6). Here every test function psi vanishes, with its
-//! first derivatives, at BOTH ends of a window [t_j, t_j + L] (Preisig & Rippin, "Theory and
-//! application of the modulating function method", Comput. Chem. Eng. 17, 1993; Shinbrot,
-//! NACA TN 3288, 1954). Multiply eq. (1) by psi and integrate over the window: by parts,
-//! `int psi y'' = int psi'' y`, `int psi y' = -int psi' y`, with no boundary term, so no
-//! initial condition and no raw (unintegrated) sample enters:
+//! noise it drifts (docs/method.md section 3.8). Here every test function psi vanishes,
+//! with its first derivatives, at BOTH ends of a window [t_j, t_j + L] (Preisig & Rippin,
+//! "Theory and application of the modulating function method", Comput. Chem. Eng. 17, 1993;
+//! Shinbrot, NACA TN 3288, 1954). Multiply eq. (1) by psi and integrate over the window: by
+//! parts, `int psi y'' = int psi'' y`, `int psi y' = -int psi' y`, with no boundary term,
+//! so no initial condition and no raw (unintegrated) sample enters:
 //!
 //! ```text
 //! eq. (1), x:  m x'' + cx x' + kx x = a (w z)' + mud (w^2 sin(phi+alpha) - w' cos(phi+alpha))

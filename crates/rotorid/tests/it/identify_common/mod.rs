@@ -21,7 +21,7 @@ pub fn rel_errors(e: &AlgebraicEstimate, truth: &[f64; 6]) -> [f64; 6] {
     std::array::from_fn(|i| (v[i] - truth[i]) / truth[i])
 }
 
-/// The three table1 cases of the accuracy targets, `duration` s long at dt = 0.1 ms.
+/// The three table1 cases of the accuracy tests, `duration` s long at dt = 0.1 ms.
 pub fn table1_cases(duration: f64) -> Vec<(&'static str, Scenario)> {
     let sampling = Sampling::new(1e-4, duration).unwrap();
     let mut cases = vec![
