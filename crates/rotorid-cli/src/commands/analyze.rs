@@ -41,8 +41,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context};
 use rotorid::analysis::{
-    campbell, critical_speeds, stability, unbalance_response, Campbell, CriticalSpeed, Parameter,
-    ParameterCovariance, Probe, Stability, UnbalanceResponse, Whirl,
+    campbell, critical_speeds, stability, unbalance_response, Campbell, CovarianceParameter,
+    CriticalSpeed, ParameterCovariance, Probe, Stability, UnbalanceResponse, Whirl,
 };
 use rotorid::model::{rad_per_s_to_rpm, rpm_to_rad_per_s};
 use rotorid::{RotorParams, Unbalance};
@@ -394,20 +394,23 @@ struct Results {
 fn rotor_std(p: &RotorParams, c: &ParameterCovariance) -> RotorStdJson {
     let (mud, alpha) = (p.unbalance.mud(), p.unbalance.alpha);
     let (s, co) = alpha.sin_cos();
-    let one = |q: Parameter| c.std(q);
+    let one = |q: CovarianceParameter| c.std(q);
     RotorStdJson {
-        m: one(Parameter::M),
-        cx: one(Parameter::Cx),
-        kx: one(Parameter::Kx),
-        cz: one(Parameter::Cz),
-        kz: one(Parameter::Kz),
-        a: one(Parameter::A),
-        mud: c.std_of_linear(&[(Parameter::MudCosAlpha, co), (Parameter::MudSinAlpha, s)]),
+        m: one(CovarianceParameter::M),
+        cx: one(CovarianceParameter::Cx),
+        kx: one(CovarianceParameter::Kx),
+        cz: one(CovarianceParameter::Cz),
+        kz: one(CovarianceParameter::Kz),
+        a: one(CovarianceParameter::A),
+        mud: c.std_of_linear(&[
+            (CovarianceParameter::MudCosAlpha, co),
+            (CovarianceParameter::MudSinAlpha, s),
+        ]),
         alpha: (mud > 0.0)
             .then(|| {
                 c.std_of_linear(&[
-                    (Parameter::MudCosAlpha, -s / mud),
-                    (Parameter::MudSinAlpha, co / mud),
+                    (CovarianceParameter::MudCosAlpha, -s / mud),
+                    (CovarianceParameter::MudSinAlpha, co / mud),
                 ])
             })
             .flatten(),

@@ -167,8 +167,11 @@ mod tests {
         assert_eq!(r.params.unbalance.mud(), 1.5e-5);
         let c = r.covariance.unwrap();
         assert_eq!(c.names(), ["m", "kx", "a"]);
-        assert_eq!(c.std(rotorid::analysis::Parameter::Kx), Some(200.0));
-        assert_eq!(c.std(rotorid::analysis::Parameter::A), None);
+        assert_eq!(
+            c.std(rotorid::analysis::CovarianceParameter::Kx),
+            Some(200.0)
+        );
+        assert_eq!(c.std(rotorid::analysis::CovarianceParameter::A), None);
         let none = GOOD.replace(
             r#"{"names": ["m", "kx", "a"], "matrix": [[1e-6, 0.05, null], [0.05, 4e4, null], [null, null, null]]}"#,
             "null",

@@ -335,3 +335,66 @@ fn balance_help_states_the_angle_convention() {
         .failure()
         .stderr(contains("give an identification summary"));
 }
+
+#[test]
+fn analyze_and_balance_read_the_summary_identify_writes() {
+    // identify (refine, unbalance unknown) -> SUMMARY.json -> analyze and balance
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("n.csv");
+    let summary = dir.path().join("s.json");
+    rotorid()
+        .args(["simulate", "--scenario", "table1", "--duration", "0.3"])
+        .args(["--snr-db", "40", "--seed", "4", "-q", "--out"])
+        .arg(&csv)
+        .assert()
+        .success();
+    rotorid()
+        .arg("identify")
+        .arg(&csv)
+        .args(["--scenario", "table1", "--method", "refine", "-q"])
+        .args([
+            "--unknowns",
+            "m,cx,kx,cz,kz,unbalance",
+            "--out",
+            "-",
+            "--summary",
+        ])
+        .arg(&summary)
+        .assert()
+        .success();
+    let s = read_json(&summary);
+    assert_eq!(crate::common::param(&s, "alpha")["determined"], true, "{s}");
+    assert!(s["rotor"].is_object() && s["covariance"].is_object(), "{s}");
+    let out = dir.path().join("a");
+    rotorid()
+        .arg("analyze")
+        .arg(&summary)
+        .args(["--rpm", "0:4000:20", "--out"])
+        .arg(&out)
+        .assert()
+        .success();
+    let j = read_json(&out.join("analysis.json"));
+    let want = table1_critical_rpm();
+    let cs = j["critical_speeds"].as_array().unwrap();
+    assert_eq!(cs.len(), 2);
+    for (c, w) in cs.iter().zip(want) {
+        let (rpm, std) = (c["rpm"].as_f64().unwrap(), c["std_rpm"].as_f64().unwrap());
+        // the identified rotor, within a few of its propagated standard deviations
+        assert!((rpm - w).abs() < 5.0 * std + 0.5, "{c} vs {w}");
+    }
+    let b = dir.path().join("b.json");
+    rotorid()
+        .arg("balance")
+        .arg(&summary)
+        .args(["--radius", "0.15", "--out"])
+        .arg(&b)
+        .assert()
+        .success();
+    let b = read_json(&b);
+    // the true unbalance is 1e-4 kg at 0.15 m, 45 deg: the correction is opposite it
+    let (mass, std) = (
+        b["mass_kg"].as_f64().unwrap(),
+        b["std_mass_kg"].as_f64().unwrap(),
+    );
+    assert!((mass - 1e-4).abs() < 5.0 * std, "{b}");
+}

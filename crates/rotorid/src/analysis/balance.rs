@@ -40,7 +40,7 @@ use nalgebra::{Complex, Matrix2, SMatrix};
 
 use crate::model::{check, RotorParams};
 
-use super::covariance::{values, Gradient, Parameter, ParameterCovariance};
+use super::covariance::{values, CovarianceParameter, Gradient, ParameterCovariance};
 use super::error::{check_params, check_speed, AnalysisError};
 use super::modes::C64;
 use super::one_x::OneX;
@@ -126,15 +126,18 @@ pub fn balance_from_unbalance(
     check("radius", radius, "finite and > 0 (m)", |v| v > 0.0)?;
     let v = values(p);
     let u = Complex::new(
-        v[Parameter::MudCosAlpha.index()],
-        v[Parameter::MudSinAlpha.index()],
+        v[CovarianceParameter::MudCosAlpha.index()],
+        v[CovarianceParameter::MudSinAlpha.index()],
     );
-    let unit = |q: Parameter| {
+    let unit = |q: CovarianceParameter| {
         let mut g: Gradient = [0.0; 8];
         g[q.index()] = 1.0;
         g
     };
-    let (gc, gs) = (unit(Parameter::MudCosAlpha), unit(Parameter::MudSinAlpha));
+    let (gc, gs) = (
+        unit(CovarianceParameter::MudCosAlpha),
+        unit(CovarianceParameter::MudSinAlpha),
+    );
     let uu = cov.and_then(|c| {
         Some(Matrix2::new(
             c.propagate_pair(&gc, &gc)?,

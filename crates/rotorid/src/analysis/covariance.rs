@@ -30,7 +30,7 @@ use super::error::AnalysisError;
 
 /// A model parameter the analysis propagates uncertainty from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-pub enum Parameter {
+pub enum CovarianceParameter {
     /// m \[kg\].
     M,
     /// cx \[N s/m\].
@@ -55,33 +55,33 @@ pub const PARAMETER_NAMES: &str = "m, cx, kx, cz, kz, a, mud_cos_alpha, mud_sin_
 /// Number of parameters: the length of every gradient.
 pub(crate) const NPARAM: usize = 8;
 
-/// A gradient (or any vector) over the parameters, indexed by [`Parameter::index`].
+/// A gradient (or any vector) over the parameters, indexed by [`CovarianceParameter::index`].
 pub(crate) type Gradient = [f64; NPARAM];
 
-impl Parameter {
+impl CovarianceParameter {
     /// Every parameter, in index order.
-    pub const ALL: [Parameter; NPARAM] = [
-        Parameter::M,
-        Parameter::Cx,
-        Parameter::Kx,
-        Parameter::Cz,
-        Parameter::Kz,
-        Parameter::A,
-        Parameter::MudCosAlpha,
-        Parameter::MudSinAlpha,
+    pub const ALL: [CovarianceParameter; NPARAM] = [
+        CovarianceParameter::M,
+        CovarianceParameter::Cx,
+        CovarianceParameter::Kx,
+        CovarianceParameter::Cz,
+        CovarianceParameter::Kz,
+        CovarianceParameter::A,
+        CovarianceParameter::MudCosAlpha,
+        CovarianceParameter::MudSinAlpha,
     ];
 
     /// The name as the refinement writes it (`m`, ..., `mud_cos_alpha`, `mud_sin_alpha`).
     pub fn name(self) -> &'static str {
         match self {
-            Parameter::M => "m",
-            Parameter::Cx => "cx",
-            Parameter::Kx => "kx",
-            Parameter::Cz => "cz",
-            Parameter::Kz => "kz",
-            Parameter::A => "a",
-            Parameter::MudCosAlpha => "mud_cos_alpha",
-            Parameter::MudSinAlpha => "mud_sin_alpha",
+            CovarianceParameter::M => "m",
+            CovarianceParameter::Cx => "cx",
+            CovarianceParameter::Kx => "kx",
+            CovarianceParameter::Cz => "cz",
+            CovarianceParameter::Kz => "kz",
+            CovarianceParameter::A => "a",
+            CovarianceParameter::MudCosAlpha => "mud_cos_alpha",
+            CovarianceParameter::MudSinAlpha => "mud_sin_alpha",
         }
     }
 
@@ -93,21 +93,21 @@ impl Parameter {
     /// SI unit.
     pub fn unit(self) -> &'static str {
         match self {
-            Parameter::M => "kg",
-            Parameter::Cx | Parameter::Cz => "N s/m",
-            Parameter::Kx | Parameter::Kz => "N/m",
-            Parameter::A => "N s^2/m",
-            Parameter::MudCosAlpha | Parameter::MudSinAlpha => "kg m",
+            CovarianceParameter::M => "kg",
+            CovarianceParameter::Cx | CovarianceParameter::Cz => "N s/m",
+            CovarianceParameter::Kx | CovarianceParameter::Kz => "N/m",
+            CovarianceParameter::A => "N s^2/m",
+            CovarianceParameter::MudCosAlpha | CovarianceParameter::MudSinAlpha => "kg m",
         }
     }
 
-    /// Position in [`Parameter::ALL`].
+    /// Position in [`CovarianceParameter::ALL`].
     pub(crate) fn index(self) -> usize {
         self as usize
     }
 }
 
-impl fmt::Display for Parameter {
+impl fmt::Display for CovarianceParameter {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }
@@ -128,7 +128,7 @@ pub struct ParameterCovariance {
     names: Vec<String>,
     matrix: Vec<Vec<f64>>,
     #[serde(skip)]
-    params: Vec<Parameter>,
+    params: Vec<CovarianceParameter>,
     /// Per row: true when the parameter is undetermined (module doc).
     #[serde(skip)]
     undetermined: Vec<bool>,
@@ -139,13 +139,30 @@ impl ParameterCovariance {
     /// once) with `matrix[i][j]` = Cov(names\[i\], names\[j\]) in SI units. Errors: an unknown
     /// or repeated name, a matrix that is not square with one row per name, a negative
     /// variance. NaN or infinite entries are accepted: they mark undetermined parameters
-    /// (module doc).
+    /// (module doc). Rows of the fit's initial state (x0, z0, vx0, vz0: nuisance
+    /// parameters) are dropped: the covariance of the others is their submatrix.
     pub fn new(names: Vec<String>, matrix: Vec<Vec<f64>>) -> Result<Self, AnalysisError> {
+        const NUISANCE: [&str; 4] = ["x0", "z0", "vx0", "vz0"];
+        if names.iter().any(|n| NUISANCE.contains(&n.as_str())) && matrix.len() == names.len() {
+            let keep: Vec<usize> = (0..names.len())
+                .filter(|&i| !NUISANCE.contains(&names[i].as_str()))
+                .collect();
+            let sub = |row: &Vec<f64>| {
+                keep.iter()
+                    .map(|&j| row.get(j).copied().unwrap_or(f64::NAN))
+                    .collect()
+            };
+            let names = keep.iter().map(|&i| names[i].clone()).collect();
+            let matrix = keep.iter().map(|&i| sub(&matrix[i])).collect();
+            return Self::new(names, matrix);
+        }
         let mut params = Vec::with_capacity(names.len());
         for name in &names {
-            let p = Parameter::from_name(name).ok_or_else(|| AnalysisError::UnknownParameter {
-                name: name.clone(),
-                allowed: PARAMETER_NAMES,
+            let p = CovarianceParameter::from_name(name).ok_or_else(|| {
+                AnalysisError::UnknownParameter {
+                    name: name.clone(),
+                    allowed: PARAMETER_NAMES,
+                }
             })?;
             if params.contains(&p) {
                 return Err(AnalysisError::DuplicateParameter { name: name.clone() });
@@ -197,19 +214,18 @@ impl ParameterCovariance {
     /// The covariance of the model parameters of a fit (its initial-state rows x0, z0,
     /// vx0, vz0 are nuisance parameters and are dropped; they do not enter the analysis).
     pub fn from_refined(r: &Refined) -> Result<Self, AnalysisError> {
-        const NUISANCE: [&str; 4] = ["x0", "z0", "vx0", "vz0"];
-        let keep: Vec<usize> = (0..r.covariance_names.len())
-            .filter(|&i| !NUISANCE.contains(&r.covariance_names[i]))
-            .collect();
-        let names = keep
+        let names = r.covariance_names.iter().map(|n| n.to_string()).collect();
+        Self::new(names, r.covariance.clone())
+    }
+
+    /// The covariance an identification reports (`None` entries: not finite).
+    pub fn from_identification(c: &crate::pipeline::Covariance) -> Result<Self, AnalysisError> {
+        let matrix = c
+            .matrix
             .iter()
-            .map(|&i| r.covariance_names[i].to_string())
+            .map(|row| row.iter().map(|v| v.unwrap_or(f64::NAN)).collect())
             .collect();
-        let matrix = keep
-            .iter()
-            .map(|&i| keep.iter().map(|&j| r.covariance[i][j]).collect())
-            .collect();
-        Self::new(names, matrix)
+        Self::new(c.names.clone(), matrix)
     }
 
     /// The parameter names, in row order.
@@ -224,14 +240,14 @@ impl ParameterCovariance {
 
     /// The standard deviation of parameter `p`: `Some(0.0)` when the covariance does not
     /// name it (known exactly), `None` when it is undetermined.
-    pub fn std(&self, p: Parameter) -> Option<f64> {
+    pub fn std(&self, p: CovarianceParameter) -> Option<f64> {
         let mut g = [0.0; NPARAM];
         g[p.index()] = 1.0;
         self.propagate(&g)
     }
 
     /// True when the covariance names `p` and `p` is determined.
-    pub fn is_determined(&self, p: Parameter) -> bool {
+    pub fn is_determined(&self, p: CovarianceParameter) -> bool {
         self.params
             .iter()
             .position(|&q| q == p)
@@ -241,7 +257,7 @@ impl ParameterCovariance {
     /// The standard deviation of a linearised result y = sum_i g_i theta_i, the gradient
     /// given as (parameter, g_i) pairs (the others 0): sqrt(g^T Sigma g) (module doc);
     /// `None` when it depends on an undetermined parameter.
-    pub fn std_of_linear(&self, gradient: &[(Parameter, f64)]) -> Option<f64> {
+    pub fn std_of_linear(&self, gradient: &[(CovarianceParameter, f64)]) -> Option<f64> {
         let mut g = [0.0; NPARAM];
         for &(p, v) in gradient {
             g[p.index()] += v;
@@ -292,9 +308,9 @@ mod tests {
 
     #[test]
     fn names_round_trip_and_are_validated() {
-        for p in Parameter::ALL {
-            assert_eq!(Parameter::from_name(p.name()), Some(p));
-            assert_eq!(Parameter::ALL[p.index()], p);
+        for p in CovarianceParameter::ALL {
+            assert_eq!(CovarianceParameter::from_name(p.name()), Some(p));
+            assert_eq!(CovarianceParameter::ALL[p.index()], p);
         }
         let e = ParameterCovariance::new(names(&["m", "k"]), vec![vec![1.0; 2]; 2]).unwrap_err();
         assert_eq!(
@@ -336,15 +352,17 @@ mod tests {
         )
         .unwrap();
         let mut g = [0.0; NPARAM];
-        g[Parameter::M.index()] = 1.0;
-        g[Parameter::Kx.index()] = -2.0;
+        g[CovarianceParameter::M.index()] = 1.0;
+        g[CovarianceParameter::Kx.index()] = -2.0;
         // 4 - 2 * 2 * 3 + 4 * 9 = 28
         assert!((c.propagate(&g).unwrap() - 28f64.sqrt()).abs() < 1e-15);
-        assert_eq!(c.std(Parameter::M), Some(2.0));
-        assert_eq!(c.std(Parameter::Cz), Some(0.0));
-        assert_eq!(c.std(Parameter::A), None);
-        assert!(c.is_determined(Parameter::Kx) && !c.is_determined(Parameter::A));
-        g[Parameter::A.index()] = 1e-30;
+        assert_eq!(c.std(CovarianceParameter::M), Some(2.0));
+        assert_eq!(c.std(CovarianceParameter::Cz), Some(0.0));
+        assert_eq!(c.std(CovarianceParameter::A), None);
+        assert!(
+            c.is_determined(CovarianceParameter::Kx) && !c.is_determined(CovarianceParameter::A)
+        );
+        g[CovarianceParameter::A.index()] = 1e-30;
         assert_eq!(c.propagate(&g), None);
     }
 }

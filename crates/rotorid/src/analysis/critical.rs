@@ -31,7 +31,7 @@ use nalgebra::{Complex, Matrix2};
 
 use crate::model::{rad_per_s_to_rpm, RotorParams};
 
-use super::covariance::{std_of, Gradient, Parameter, ParameterCovariance, NPARAM};
+use super::covariance::{std_of, CovarianceParameter, Gradient, ParameterCovariance, NPARAM};
 use super::error::{check_params, check_speeds, AnalysisError};
 use super::modes::{Mode, Quadratic, Whirl, C64};
 
@@ -153,12 +153,12 @@ pub(crate) fn eigenvalue_derivatives(
     let e22 = Matrix2::new(zero, zero, zero, one);
     let d = |dq: Matrix2<C64>| -(r * dq * u)[(0, 0)] / denom;
     let mut out = [zero; NPARAM];
-    out[Parameter::M.index()] = d(Matrix2::identity() * (l * l));
-    out[Parameter::Cx.index()] = d(e11 * l);
-    out[Parameter::Kx.index()] = d(e11);
-    out[Parameter::Cz.index()] = d(e22 * l);
-    out[Parameter::Kz.index()] = d(e22);
-    out[Parameter::A.index()] = d(j * (l * w));
+    out[CovarianceParameter::M.index()] = d(Matrix2::identity() * (l * l));
+    out[CovarianceParameter::Cx.index()] = d(e11 * l);
+    out[CovarianceParameter::Kx.index()] = d(e11);
+    out[CovarianceParameter::Cz.index()] = d(e22 * l);
+    out[CovarianceParameter::Kz.index()] = d(e22);
+    out[CovarianceParameter::A.index()] = d(j * (l * w));
     Some((out, d(j * (l * p.a))))
 }
 

@@ -60,7 +60,7 @@ pub use balance::{
     balance_from_runs, balance_from_unbalance, response_per_unbalance, Correction,
     InfluenceBalance, ModelBalance, RunVectors, TrialMass,
 };
-pub use covariance::{Parameter, ParameterCovariance, PARAMETER_NAMES};
+pub use covariance::{CovarianceParameter, ParameterCovariance, PARAMETER_NAMES};
 pub use critical::{critical_speeds, CriticalSpeed};
 pub use error::AnalysisError;
 pub use modes::{campbell, modes, Campbell, Mode, Whirl, PLANAR_WHIRL};

@@ -35,7 +35,9 @@ use nalgebra::{Complex, Matrix2, Vector2};
 
 use crate::model::{check, RotorParams};
 
-use super::covariance::{std_of, values, Gradient, Parameter, ParameterCovariance, NPARAM};
+use super::covariance::{
+    std_of, values, CovarianceParameter, Gradient, ParameterCovariance, NPARAM,
+};
 use super::error::{check_params, check_speeds, AnalysisError};
 use super::modes::C64;
 
@@ -175,8 +177,8 @@ pub(crate) fn response_and_gradient(
     let (h, inv) = transfer(p, w)?;
     let v = values(p);
     let u = Complex::new(
-        v[Parameter::MudCosAlpha.index()],
-        v[Parameter::MudSinAlpha.index()],
+        v[CovarianceParameter::MudCosAlpha.index()],
+        v[CovarianceParameter::MudSinAlpha.index()],
     );
     let pv = h * u;
     let zero = Complex::new(0.0, 0.0);
@@ -186,14 +188,14 @@ pub(crate) fn response_and_gradient(
     let j = Matrix2::new(zero, -Complex::new(1.0, 0.0), Complex::new(1.0, 0.0), zero);
     let dp = |dd: Matrix2<C64>| -(inv * dd * pv);
     let mut g = [Vector2::new(zero, zero); NPARAM];
-    g[Parameter::M.index()] = dp(Matrix2::identity() * Complex::new(-w * w, 0.0));
-    g[Parameter::Cx.index()] = dp(e11 * (i * w));
-    g[Parameter::Kx.index()] = dp(e11);
-    g[Parameter::Cz.index()] = dp(e22 * (i * w));
-    g[Parameter::Kz.index()] = dp(e22);
-    g[Parameter::A.index()] = dp(j * (i * w * w));
-    g[Parameter::MudCosAlpha.index()] = h;
-    g[Parameter::MudSinAlpha.index()] = h * i;
+    g[CovarianceParameter::M.index()] = dp(Matrix2::identity() * Complex::new(-w * w, 0.0));
+    g[CovarianceParameter::Cx.index()] = dp(e11 * (i * w));
+    g[CovarianceParameter::Kx.index()] = dp(e11);
+    g[CovarianceParameter::Cz.index()] = dp(e22 * (i * w));
+    g[CovarianceParameter::Kz.index()] = dp(e22);
+    g[CovarianceParameter::A.index()] = dp(j * (i * w * w));
+    g[CovarianceParameter::MudCosAlpha.index()] = h;
+    g[CovarianceParameter::MudSinAlpha.index()] = h * i;
     Some((pv, g))
 }
 

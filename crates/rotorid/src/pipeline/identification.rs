@@ -304,7 +304,7 @@ pub struct Identification {
     pub noise: Option<Noise>,
     /// What to read before trusting the numbers, worst first.
     pub diagnostics: Vec<Diagnostic>,
-    /// The algebraic identifier's figures (method algebraic, or refine started from it).
+    /// The algebraic identifier's figures (method algebraic).
     pub algebraic: Option<AlgebraicDetail>,
     /// The modulating identifier's figures (method modulating, or refine started from it).
     pub modulating: Option<ModulatingDetail>,

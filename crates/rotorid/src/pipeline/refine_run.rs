@@ -3,14 +3,14 @@
 //! meaningful, and the rule that withholds what the record does not determine.
 //!
 //! A parameter is determined when its standard error is finite and no larger than its
-//! value, and the data separate the unknowns (no not-identifiable or ill-conditioned
+//! value (alpha: no larger than 1 rad), and the data separate the unknowns (no not-identifiable or ill-conditioned
 //! finding). The bound is evaluated at the truth when the caller knows all of m, c, k
 //! (with the true initial state when the record starts at t = 0, else the fitted one),
 //! otherwise at the estimate; always with the fitted noise.
 
 use crate::model::{InitialState, RotorParams};
 use crate::parameter::Parameter;
-use crate::refine::{crb, refine, RefineOptions, Refined, Unknowns};
+use crate::refine::{crb, refine, RefineOptions, Refined, Unknowns, ALPHA_STD_LIMIT};
 
 use super::diagnostic::{Diagnostic, Finding};
 use super::error::PipelineError;
@@ -76,8 +76,12 @@ pub(crate) fn run(
         .filter_map(|e| {
             let p: Parameter = e.name.parse().ok()?;
             let rel = e.relative_std_error;
-            let determined =
-                e.std_error.is_finite() && rel.is_some_and(|r| r <= 1.0) && !inseparable;
+            // an angle has no relative error: alpha is determined to within 1 rad
+            let small = match p {
+                Parameter::Alpha => e.std_error <= ALPHA_STD_LIMIT,
+                _ => rel.is_some_and(|r| r <= 1.0),
+            };
+            let determined = e.std_error.is_finite() && small && !inseparable;
             let truth = k.truth_of(p);
             let value = determined.then_some(e.value);
             Some(ParameterResult {

@@ -12,7 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rotorid::analysis::{
     balance_from_runs, balance_from_unbalance, campbell, critical_speeds, modes, one_x,
-    response_per_unbalance, stability, unbalance_response, AnalysisError, Parameter,
+    response_per_unbalance, stability, unbalance_response, AnalysisError, CovarianceParameter,
     ParameterCovariance, Probe, RunVectors, TrialMass, Whirl,
 };
 use rotorid::model::{rpm_to_rad_per_s, InitialState, Rotor, RotorParams, Scenario, Unbalance};
@@ -285,7 +285,7 @@ fn covariance(p: &RotorParams, rel: [f64; 8], corr: &[(usize, usize, f64)]) -> D
 
 fn parameter_covariance(c: &DMatrix<f64>) -> ParameterCovariance {
     ParameterCovariance::new(
-        Parameter::ALL
+        CovarianceParameter::ALL
             .iter()
             .map(|p| p.name().to_string())
             .collect(),
@@ -405,7 +405,7 @@ fn linearised_standard_deviations_agree_with_monte_carlo() {
     let r = unbalance_response(&p, Some(&u_bad), &[probe_speed], &[Probe::X]).unwrap();
     assert_eq!(r.channels[0].points[0].unwrap().std_amplitude, None);
     let m_bad = ParameterCovariance::new(names, undetermined(pc.matrix(), 0)).unwrap();
-    assert_eq!(m_bad.std(Parameter::M), None);
+    assert_eq!(m_bad.std(CovarianceParameter::M), None);
     let c = critical_speeds(&p, Some(&m_bad), &speeds).unwrap();
     assert_eq!((c[0].std, c[1].std), (None, None));
 }

@@ -13,7 +13,7 @@ pub struct DirectionEstimate {
     /// Stiffness k \[N/m\] (NaN when singular).
     pub k: f64,
     /// Reciprocal 1-norm condition number of the scaled 3x3 system, in [0, 1]
-    /// (0 when singular); see [`super::system`] for its exact definition.
+    /// (0 when singular); see [`super::scaled_solve`] for its exact definition.
     pub rcond: f64,
 }
 
@@ -61,7 +61,7 @@ impl AlgebraicEstimate {
     }
 
     /// The six values in the order m_x, c_x, k_x, m_z, c_z, k_z
-    /// (see [`super::Parameter`]).
+    /// (see [`crate::Parameter::PER_DIRECTION`]).
     pub fn values(&self) -> [f64; 6] {
         [self.x.m, self.x.c, self.x.k, self.z.m, self.z.c, self.z.k]
     }

@@ -2,7 +2,7 @@
 //! squares over many windows (docs/method.md section 4: a robust variant of the paper's
 //! algebraic identifier).
 //!
-//! The algebraic identifier (Barredo et al. 2024; [`super::AlgebraicIdentifier`]) is a
+//! The algebraic identifier (Barredo et al. 2024; [`super::algebraic::AlgebraicIdentifier`]) is a
 //! modulating-function method whose kernel tau^2 = (t - t_0)^2 vanishes only at t_0: its
 //! P\[y\] holds the raw sample tau^2 y(t) and the weights tau^n grow with time, so under
 //! noise it drifts (docs/method.md section 3.8). Here every test function psi vanishes,
