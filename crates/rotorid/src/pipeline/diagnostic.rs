@@ -115,6 +115,20 @@ pub enum Finding {
         /// All stamps.
         samples: usize,
     },
+    /// The model does not explain a channel of the record (see `adequacy`): its residuals
+    /// are not white or exceed the data's noise level. The values are withheld.
+    ModelInadequate {
+        /// The channel.
+        direction: Direction,
+        /// Ljung-Box p-value of the residuals.
+        ljung_box_p: f64,
+        /// Lag-1 autocorrelation of the residuals.
+        lag1_autocorrelation: f64,
+        /// Residual level over the data's noise level.
+        noise_ratio: f64,
+        /// The residual's dominant frequency \[Hz\].
+        dominant_frequency_hz: Option<f64>,
+    },
     /// The Cramer-Rao bound could not be computed.
     CrbUnavailable {
         /// Why.
@@ -230,6 +244,24 @@ fn message(f: &Finding) -> String {
              estimates are biased by about twice that; identify the whole record as a file \
              (its grid is fitted over every stamp) or give the sampling period",
             (dt_all_s - dt_used_s).abs() / dt_used_s
+        ),
+        Finding::ModelInadequate {
+            direction,
+            ljung_box_p,
+            lag1_autocorrelation,
+            noise_ratio,
+            dominant_frequency_hz,
+        } => format!(
+            "MODEL INADEQUATE for {}: the fit leaves structure in its residuals (Ljung-Box \
+             p = {ljung_box_p:.1e} over {} lags, lag-1 autocorrelation {lag1_autocorrelation:.2}; \
+             residual {noise_ratio:.2}x the noise level of the data{}): a nonlinear support, \
+             an unmodelled mode or a wrong speed signal? The standard errors assume a correct \
+             model, so every value is withheld (the raw numbers stay in `estimate`)",
+            direction.name(),
+            super::adequacy::LJUNG_BOX_LAGS,
+            dominant_frequency_hz.map_or(String::new(), |f| format!(
+                "; dominant residual frequency {f:.1} Hz"
+            ))
         ),
         Finding::CrbUnavailable { reason } => {
             format!("the Cramer-Rao bound was not computed: {reason}")

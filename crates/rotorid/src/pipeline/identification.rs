@@ -302,6 +302,8 @@ pub struct Identification {
     pub covariance: Option<Covariance>,
     /// The noise level, when the method estimates it.
     pub noise: Option<Noise>,
+    /// refine: whether the model explains the record (residual tests per channel).
+    pub adequacy: Option<super::adequacy::Adequacy>,
     /// What to read before trusting the numbers, worst first.
     pub diagnostics: Vec<Diagnostic>,
     /// The algebraic identifier's figures (method algebraic).

@@ -20,6 +20,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod adequacy;
 mod diagnostic;
 mod error;
 mod grid;
@@ -31,6 +32,9 @@ mod refine_run;
 mod session;
 mod start;
 
+pub use adequacy::{
+    Adequacy, ChannelAdequacy, ADEQUACY_P_MIN, LJUNG_BOX_LAGS, NOISE_RATIO_MAX, RESIDUAL_FLOOR,
+};
 pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};
 pub use error::PipelineError;
 pub use grid::{RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE, SNAP_DT, SNAP_T0};
@@ -192,6 +196,7 @@ fn algebraic_identification(
         parameters,
         covariance: None,
         noise: None,
+        adequacy: None,
         diagnostics: Vec::new(),
         algebraic: Some(AlgebraicDetail {
             quadrature: s.quadrature,
@@ -276,6 +281,7 @@ fn modulating_identification(
             sigma_z_m: e.sigma_z,
             source: NoiseSource::FourthDifferences,
         }),
+        adequacy: None,
         diagnostics,
         algebraic: None,
         modulating: Some(modulating_detail(e, rcond_min)),

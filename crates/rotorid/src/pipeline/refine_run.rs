@@ -4,15 +4,18 @@
 //!
 //! A parameter is determined when its standard error is finite and no larger than its
 //! value (alpha: no larger than 1 rad), and the data separate the unknowns (no not-identifiable or ill-conditioned
-//! finding). The bound is evaluated at the truth when the caller knows all of m, c, k
+//! finding) and the model explains the record (module `adequacy`). The bound is evaluated at the truth when the caller knows all of m, c, k
 //! (with the true initial state when the record starts at t = 0, else the fitted one),
 //! otherwise at the estimate; always with the fitted noise.
 
 use crate::model::{InitialState, RotorParams};
 use crate::parameter::Parameter;
-use crate::refine::{crb, refine, RefineOptions, Refined, Unknowns, ALPHA_STD_LIMIT};
+use crate::refine::{
+    crb, model_response, refine, Discretisation, RefineOptions, Refined, Unknowns, ALPHA_STD_LIMIT,
+};
 
-use super::diagnostic::{Diagnostic, Finding};
+use super::adequacy::Adequacy;
+use super::diagnostic::{Diagnostic, Direction, Finding};
 use super::error::PipelineError;
 use super::identification::StartSource;
 use super::identification::{
@@ -68,7 +71,25 @@ pub(crate) fn run(
             None
         }
     };
-    let inseparable = diagnostics.iter().any(Diagnostic::inseparable);
+    let adequacy = adequacy(rec, &fit);
+    if let Some(a) = &adequacy {
+        for (direction, c) in [(Direction::X, &a.x), (Direction::Z, &a.z)] {
+            if !c.adequate {
+                diagnostics.insert(
+                    0,
+                    Diagnostic::new(Finding::ModelInadequate {
+                        direction,
+                        ljung_box_p: c.ljung_box_p,
+                        lag1_autocorrelation: c.lag1_autocorrelation,
+                        noise_ratio: c.noise_ratio,
+                        dominant_frequency_hz: c.dominant_frequency_hz,
+                    }),
+                );
+            }
+        }
+    }
+    let inadequate = adequacy.is_some_and(|a| !a.model_adequate);
+    let inseparable = diagnostics.iter().any(Diagnostic::inseparable) || inadequate;
     let t_last = *rec.t().last().unwrap_or(&f64::NAN);
     let parameters: Vec<ParameterResult> = fit
         .parameters
@@ -119,6 +140,7 @@ pub(crate) fn run(
             sigma_z_m: fit.sigma_z,
             source: NoiseSource::Residuals,
         }),
+        adequacy,
         diagnostics,
         algebraic: None,
         modulating: found
@@ -147,6 +169,27 @@ pub(crate) fn run(
             crb_at: bound.map(|(_, at)| at),
         }),
         estimates: Vec::new(),
+    })
+}
+
+/// The residual tests of the fit (module `adequacy`); `None` when the model response
+/// cannot be computed.
+fn adequacy(rec: &Record, fit: &Refined) -> Option<Adequacy> {
+    let record = rec.for_refine();
+    let model = model_response(
+        &fit.rotor,
+        &fit.initial,
+        &record.experiment(),
+        Discretisation::Auto,
+    )
+    .ok()?;
+    let dt = rec.grid().dt;
+    let x = super::adequacy::channel(rec.x(), &model.x, dt);
+    let z = super::adequacy::channel(rec.z(), &model.z, dt);
+    Some(Adequacy {
+        model_adequate: x.adequate && z.adequate,
+        x,
+        z,
     })
 }
 

@@ -3,6 +3,7 @@
 
 mod identify_common;
 
+mod adequacy;
 mod analysis;
 mod identify_accuracy;
 mod identify_conditioning;

@@ -53,7 +53,7 @@ mod config;
 mod error;
 mod estimate;
 mod identifier;
-mod noise_estimate;
+pub(crate) mod noise_estimate;
 mod normal_equations;
 mod test_functions;
 mod uncertainty;
