@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 
-use crate::io::columns::{csv_reader, normalise, read_error};
+use crate::io::columns::{csv_reader, next_record, normalise};
 use crate::io::{
     open_input, EstimateRow, EstimatesReader, ResponseReader, ScenarioSpec, Truth,
     DEFAULT_TIME_TOLERANCE, ESTIMATES_HEADER,
@@ -113,10 +113,7 @@ pub fn run(args: PlotArgs) -> anyhow::Result<()> {
 pub fn detect(name: &str, bytes: &[u8]) -> anyhow::Result<CsvKind> {
     let mut csv = csv_reader(bytes);
     let mut rec = csv::ByteRecord::new();
-    if !csv
-        .read_byte_record(&mut rec)
-        .map_err(|e| read_error(name, e))?
-    {
+    if next_record(name, &mut csv, &mut rec)?.is_none() {
         bail!("{name}: the file is empty: expected a CSV header (t,x,z,... or t,m_x,...,rcond_z)");
     }
     let names: Vec<String> = rec.iter().map(normalise).collect();

@@ -15,6 +15,7 @@
 pub mod columns;
 pub mod csv_error;
 pub mod estimates_csv;
+pub mod lines;
 pub mod number;
 pub mod output;
 pub mod params;
