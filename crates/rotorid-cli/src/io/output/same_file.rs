@@ -3,8 +3,9 @@
 //! Files are compared by what they are, not by how they are named: device and inode (so
 //! `a.csv`, `./a.csv`, a hard link and a symbolic link to it are one file) and, for an
 //! output that does not exist yet, the device and inode of its directory and its file
-//! name. Character devices (`/dev/null`, a terminal) are never "the same file": two
-//! outputs to /dev/null destroy nothing. `-` is stdin for an input and stdout for an
+//! name. Character devices (`/dev/null`, a terminal) and sockets are never "the same
+//! file": two outputs to /dev/null destroy nothing, and a socket (or a terminal) is
+//! rightly both stdin and stdout of a program run over a connection. `-` is stdin for an input and stdout for an
 //! output, compared through file descriptors 0 and 1, so `identify in.csv --out - >>in.csv`
 //! is refused too.
 //!
@@ -58,12 +59,12 @@ pub(super) fn resolve(path: &Path) -> io::Result<PathBuf> {
     Err(io::Error::other("too many levels of symbolic links"))
 }
 
-/// The identity of the file `path` names (module doc); `None` for a character device or
-/// a path that cannot be examined.
+/// The identity of the file `path` names (module doc); `None` for a character device, a
+/// socket or a path that cannot be examined.
 pub(super) fn of_path(path: &Path) -> Option<FileId> {
     let path = resolve(path).ok()?;
     let node = match std::fs::metadata(&path) {
-        Ok(m) if m.file_type().is_char_device() => return None,
+        Ok(m) if m.file_type().is_char_device() || m.file_type().is_socket() => return None,
         Ok(m) => Some((m.dev(), m.ino())),
         Err(_) => None,
     };
@@ -79,14 +80,15 @@ pub(super) fn of_path(path: &Path) -> Option<FileId> {
 }
 
 /// The identity of the file open as descriptor `fd` (0: stdin, 1: stdout); `None` for a
-/// character device (a terminal, /dev/null) or a closed descriptor.
+/// character device (a terminal, /dev/null), a socket or a closed descriptor.
 pub(super) fn of_fd(fd: libc::c_int) -> Option<FileId> {
     // SAFETY: fstat writes into the zeroed struct we own; an invalid fd is an error return.
     let st = unsafe {
         let mut st: libc::stat = std::mem::zeroed();
         (libc::fstat(fd, &mut st) == 0).then_some(st)
     }?;
-    if st.st_mode & libc::S_IFMT == libc::S_IFCHR {
+    let kind = st.st_mode & libc::S_IFMT;
+    if kind == libc::S_IFCHR || kind == libc::S_IFSOCK {
         return None;
     }
     Some(FileId {
