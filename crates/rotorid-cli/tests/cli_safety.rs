@@ -90,6 +90,10 @@ struct Measured {
 
 /// Run `cmd` to its end, collecting its output and its peak resident set (`ru_maxrss`
 /// of `wait4`, exact: the kernel's own high-water mark).
+#[expect(
+    clippy::zombie_processes,
+    reason = "reaped by wait4, which also gives the peak"
+)]
 fn measured(cmd: &mut Command) -> Measured {
     let mut child = cmd
         .stdout(Stdio::piped())
@@ -634,6 +638,10 @@ fn a_full_disk_leaves_whole_rows_or_nothing_and_names_the_output() {
 
 /// Start a long `simulate` to a file in a fresh directory, send `sig` once it has run a
 /// while, and return the directory's content after it died.
+#[expect(
+    clippy::zombie_processes,
+    reason = "reaped by wait4, which also gives the peak"
+)]
 fn interrupted(sig: i32, named_temporary: bool) -> (Measured, Vec<String>) {
     let dir = tempfile::tempdir().unwrap();
     let mut cmd = Command::new(bin());

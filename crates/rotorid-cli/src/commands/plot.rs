@@ -29,10 +29,9 @@ use crate::io::columns::{csv_reader, io_error, next_record, normalise};
 use crate::io::csv_error::abbreviate;
 use crate::io::lines::LineReader;
 use crate::io::number::readable;
-use crate::io::output::check_distinct_files;
 use crate::io::{
-    open_input, EstimatesReader, ResponseReader, ScenarioSpec, Truth, DEFAULT_TIME_TOLERANCE,
-    ESTIMATES_HEADER,
+    check_distinct_files, open_input, EstimatesReader, ResponseReader, ScenarioSpec, Truth,
+    DEFAULT_TIME_TOLERANCE, ESTIMATES_HEADER,
 };
 use crate::plot::scale::si_prefix;
 use crate::plot::thin::{ColumnThinner, PathThinner, Subsample};

@@ -19,10 +19,10 @@
 use anyhow::Context as _;
 use rotorid::simulate::{add_noise, integrator, Method, TimeResponse};
 
-use crate::io::output::check_distinct_files;
 use crate::io::progress::Progress;
 use crate::io::{
-    is_broken_pipe, FileMode, Output, ResponseWriter, ScenarioSpec, SimulationOverrides,
+    check_distinct_files, is_broken_pipe, FileMode, Output, ResponseWriter, ScenarioSpec,
+    SimulationOverrides,
 };
 
 const SIMULATE_EXAMPLES: &str =

@@ -9,8 +9,8 @@
 //!
 //! Numbers are written in shortest round-trip form ([`number`]): reading a value back gives
 //! the identical `f64`. Readers report errors as `FILE line L, column C (NAME): ...`
-//! ([`CsvError`]). Outputs go to stdout (`-`) or to a file, atomically or in place
-//! ([`output`]).
+//! ([`CsvError`]), with lines counted and capped in length by [`lines`]. Outputs go to
+//! stdout (`-`) or to a file, atomically or in place, never over an input ([`output`]).
 
 pub mod columns;
 pub mod csv_error;
@@ -26,7 +26,10 @@ pub mod summary;
 
 pub use csv_error::CsvError;
 pub use estimates_csv::{EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES_HEADER};
-pub use output::{is_broken_pipe, open_input, FileMode, FlushBeforeRead, Output, SharedWriter};
+pub use output::{
+    check_distinct_files, is_broken_pipe, open_input, FileMode, FlushBeforeRead, Output,
+    SharedWriter,
+};
 pub use params::ParameterSet;
 pub use response_csv::{ResponseReader, ResponseRow, ResponseWriter, DEFAULT_TIME_TOLERANCE};
 pub use scenario::{IdentificationScenario, ScenarioSpec, SimulationOverrides, Truth};
