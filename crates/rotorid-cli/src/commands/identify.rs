@@ -13,11 +13,19 @@ use anyhow::Context as _;
 use args::method_of;
 
 use crate::io::LoadScenario as _;
-use crate::io::{is_broken_pipe, open_input, FileMode, Output, ScenarioSpec};
+use crate::io::{check_distinct_files, is_broken_pipe, open_input, FileMode, Output, ScenarioSpec};
 
 /// Run `rotorid identify`: scenario and options -> pipeline -> outputs.
 pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     let method = method_of(&args)?;
+    let mut outputs = vec![("--out", args.out.as_str())];
+    if let Some(s) = &args.summary {
+        outputs.push(("--summary", s.as_str()));
+    }
+    check_distinct_files(
+        &[("the input", &args.input), ("--scenario", &args.scenario)],
+        &outputs,
+    )?;
     let spec = ScenarioSpec::load(&args.scenario)?;
     let (name, input) = open_input(&args.input)?;
     let live = args.input == "-" || !std::fs::metadata(&args.input).is_ok_and(|m| m.is_file());

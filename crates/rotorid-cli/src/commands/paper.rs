@@ -9,14 +9,18 @@
 //!   0.3 s, relative error, identification time (1 %), the paper's reported time;
 //! - `report.md` and `report.html` (self-contained, figures embedded).
 //!
+//! Every file is written atomically (a temporary renamed over it when complete; see
+//! [`crate::io::output`]): an interrupted run leaves the previous files whole.
+//!
 //! See [`crate::report`] for the experiments and definitions.
 
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write as _};
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use crate::io::{FileMode, Output};
 use crate::plot;
 use crate::report::experiment::{self, Case, Run, Setting, PAPER_DT};
 use crate::report::figures::case_figures;
@@ -188,9 +192,14 @@ fn take(runs: &mut Vec<Run>, setting: Setting) -> Run {
     runs.swap_remove(i)
 }
 
+/// Write `contents` to `dir/name` atomically (see [`crate::io::output`]).
 fn write(dir: &Path, name: &str, contents: String) -> anyhow::Result<()> {
     let path = dir.join(name);
-    std::fs::write(&path, contents).with_context(|| format!("cannot write {}", path.display()))
+    let shown = path.to_string_lossy();
+    let mut out = Output::create(&shown, FileMode::Atomic)?;
+    out.write_all(contents.as_bytes())
+        .with_context(|| format!("cannot write {shown}"))?;
+    out.commit()
 }
 
 /// A bar on stderr when it is a terminal and not `--quiet`; hidden otherwise.

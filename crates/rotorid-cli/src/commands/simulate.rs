@@ -12,15 +12,18 @@
 //! not grow with the record). With `--snr-db` the whole record is held in memory
 //! (6 x 8 bytes per sample), because the noise level is relative to each channel's RMS
 //! over the whole record (`rotorid::simulate::add_noise`, docs/method.md section 2.5).
-//! A file output appears only once complete (temporary file + rename).
+//! A file output appears only once complete (temporary file + rename; see
+//! [`crate::io::output`]); it may not be the scenario file. Runs that take more than a
+//! moment report their progress on stderr ([`crate::io::progress`]).
 
 use anyhow::Context as _;
 use rotorid::simulate::{add_noise, integrator, Method, TimeResponse};
 
-use crate::io::progress::{progress_bar, PROGRESS_STRIDE};
+use crate::io::progress::Progress;
 use crate::io::LoadScenario as _;
 use crate::io::{
-    is_broken_pipe, FileMode, Output, ResponseWriter, ScenarioSpec, SimulationOverrides,
+    check_distinct_files, is_broken_pipe, FileMode, Output, ResponseWriter, ScenarioSpec,
+    SimulationOverrides,
 };
 
 const SIMULATE_EXAMPLES: &str =
@@ -120,6 +123,7 @@ impl From<MethodArg> for Method {
 
 /// Run `rotorid simulate`.
 pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
+    check_distinct_files(&[("--scenario", &args.scenario)], &[("--out", &args.out)])?;
     let spec = ScenarioSpec::load(&args.scenario)?;
     let scenario = spec.simulation(&SimulationOverrides {
         dt: args.dt,
@@ -150,7 +154,7 @@ fn write_response(
     let name = out.name().to_owned();
     let mut w = ResponseWriter::new(out).with_context(|| format!("cannot write {name}"))?;
     let mut integ = integrator(scenario, method)?;
-    let pb = progress_bar(n as u64, &format!("simulate ({method})"));
+    let mut progress = Progress::new(n as u64, &format!("simulate ({method})"));
     match args.snr_db {
         None => {
             let s = integ.current();
@@ -160,9 +164,7 @@ fn write_response(
                 let s = integ.step()?;
                 w.write(s.t, s.x, s.z, &s.speed)
                     .with_context(|| format!("cannot write {name}"))?;
-                if i as u64 % PROGRESS_STRIDE == 0 {
-                    pb.set_position(i as u64);
-                }
+                progress.update(i as u64);
             }
         }
         Some(snr_db) => {
@@ -170,9 +172,7 @@ fn write_response(
             resp.push(&integ.current());
             for i in 1..n {
                 resp.push(&integ.step()?);
-                if i as u64 % PROGRESS_STRIDE == 0 {
-                    pb.set_position(i as u64);
-                }
+                progress.update(i as u64);
             }
             let seed = args.seed.unwrap_or(0);
             let level = add_noise(&mut resp, snr_db, seed)?;
@@ -194,6 +194,6 @@ fn write_response(
             }
         }
     }
-    pb.finish_and_clear();
+    progress.finish();
     w.into_inner().commit()
 }

@@ -5,10 +5,24 @@
 //! dropping one trailing unit suffix in brackets or parentheses (`x [m]`, `phi_dot (rad/s)`)
 //! and lower-casing, so `t,x,z`, `T [s],X [m],Z [m]` and `t (s), x (m), z (m)` all name the
 //! same columns. The unit in a suffix is not checked: values are always read as SI.
+//!
+//! Limits: a line (header included) holds at most [`MAX_LINE_BYTES`] ([`super::lines`]),
+//! a number field at most [`MAX_FIELD_BYTES`]; messages quote at most a short prefix of a
+//! bad value ([`super::csv_error::quote`]).
+
+use std::io::Read;
 
 use csv::ByteRecord;
 
-use super::csv_error::CsvError;
+use super::csv_error::{abbreviate, quote, CsvError, WriteFailure};
+use super::lines::{LineReader, LineTooLong, MAX_LINE_BYTES};
+
+/// The longest number field accepted, in bytes (the shortest round-trip text of any `f64`
+/// has at most 24).
+pub const MAX_FIELD_BYTES: usize = 1024;
+
+/// Header names quoted in a message, at most this many characters in all.
+const HEADER_QUOTE_CHARS: usize = 200;
 
 /// The normalised column name (see the module doc).
 pub fn normalise(raw: &[u8]) -> String {
@@ -88,7 +102,7 @@ impl Header {
                     if missing.len() > 1 { "s" } else { "" },
                     missing.join(", "),
                     required.join(","),
-                    self.names.join(",")
+                    abbreviate(&self.names.join(","), HEADER_QUOTE_CHARS)
                 ),
             ))
         }
@@ -127,6 +141,19 @@ pub fn number_field(
     name: &str,
 ) -> Result<f64, CsvError> {
     let raw = rec.get(col).unwrap_or_default();
+    if raw.len() > MAX_FIELD_BYTES {
+        return Err(CsvError::field(
+            file,
+            line,
+            col,
+            name,
+            format!(
+                "{name} {} is {} bytes long: a number field may hold at most {MAX_FIELD_BYTES}",
+                quote(raw),
+                raw.len()
+            ),
+        ));
+    }
     std::str::from_utf8(raw)
         .ok()
         .and_then(|s| s.trim().parse::<f64>().ok())
@@ -135,7 +162,7 @@ pub fn number_field(
             let what = if text.trim().is_empty() {
                 "is empty".to_owned()
             } else {
-                format!("{:?} is not a number", text.trim())
+                format!("{} is not a number", quote(text.trim().as_bytes()))
             };
             CsvError::field(
                 file,
@@ -164,30 +191,76 @@ pub fn optional_field(
     Ok((!v.is_nan()).then_some(v))
 }
 
+/// The CSV reader of every file here: lines numbered and capped by a [`LineReader`].
+pub type CsvReader<R> = csv::Reader<LineReader<R>>;
+
 /// A CSV reader configured as every reader here needs it: no header handling (we read the
 /// header ourselves to know its line), rows of any length (checked by the caller, with a
-/// better message), blanks trimmed around fields.
-pub fn csv_reader<R: std::io::Read>(input: R) -> csv::Reader<R> {
+/// better message), blanks trimmed around fields, lines numbered and capped
+/// ([`super::lines`]).
+pub fn csv_reader<R: Read>(input: R) -> CsvReader<R> {
     csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
         .buffer_capacity(64 * 1024)
-        .from_reader(input)
+        .from_reader(LineReader::new(input))
 }
 
-/// Map a `csv` crate error (I/O, mostly) to a [`CsvError`] for `file`.
-pub fn read_error(file: &str, e: csv::Error) -> CsvError {
-    let line = e.position().map(|p| p.line());
-    let kind = match e.kind() {
-        csv::ErrorKind::Io(io) => Some(io.kind()),
-        _ => None,
+/// Read the next record of `csv` into `rec`: the line it begins on (1-based, LF, CRLF and
+/// CR line ends alike), or `None` at the end of the input.
+pub fn next_record<R: Read>(
+    file: &str,
+    csv: &mut CsvReader<R>,
+    rec: &mut ByteRecord,
+) -> Result<Option<u64>, CsvError> {
+    csv.get_mut().mark();
+    match csv.read_byte_record(rec) {
+        Ok(true) => Ok(Some(csv.get_ref().record_line())),
+        Ok(false) => Ok(None),
+        Err(e) => Err(read_error(file, e, csv.get_ref().line())),
+    }
+}
+
+/// Map a `csv` crate error (I/O, mostly) met at `line` to a [`CsvError`] for `file`. A
+/// line over the cap names the cap; a failed write of the output (flushed before a read,
+/// see [`super::FlushBeforeRead`]) names the output, not the input.
+pub fn read_error(file: &str, e: csv::Error, line: u64) -> CsvError {
+    match e.kind() {
+        csv::ErrorKind::Io(io) => io_error(file, io, line),
+        _ => CsvError::line(file, line, format!("cannot read: {e}")),
+    }
+}
+
+/// [`read_error`] for an I/O error met at `line` of `file`.
+pub fn io_error(file: &str, io: &std::io::Error, line: u64) -> CsvError {
+    let inner = io.get_ref();
+    if let Some(t) = inner.and_then(|i| i.downcast_ref::<LineTooLong>()) {
+        let what = if t.line == 1 {
+            "the header line"
+        } else {
+            "the line"
+        };
+        return CsvError::line(
+            file,
+            t.line,
+            format!(
+                "{what} is longer than {} bytes{}, the most one line may hold: is this a CSV \
+                 file with line ends (LF, CRLF or CR)?",
+                t.cap,
+                if t.cap == MAX_LINE_BYTES {
+                    " (1 MiB)"
+                } else {
+                    ""
+                }
+            ),
+        );
+    }
+    let mut err = match inner.and_then(|i| i.downcast_ref::<WriteFailure>()) {
+        Some(w) => CsvError::file(&w.output, format!("cannot write: {w}")),
+        None => CsvError::line(file, line, format!("cannot read: {io}")),
     };
-    let mut err = match line {
-        Some(l) => CsvError::line(file, l, format!("cannot read: {e}")),
-        None => CsvError::file(file, format!("cannot read: {e}")),
-    };
-    err.io_kind = kind;
+    err.io_kind = Some(io.kind());
     err
 }
 
@@ -225,6 +298,50 @@ mod tests {
         assert_eq!(normalise("\u{feff}T".as_bytes()), "t");
         assert_eq!(normalise(b"[m]"), "[m]");
         assert_eq!(normalise(b"rcond_x"), "rcond_x");
+    }
+
+    #[test]
+    fn long_fields_and_headers_are_quoted_short() {
+        let long = "9".repeat(2000);
+        let rec = ByteRecord::from(vec![long.as_str(), "x".repeat(500).as_str()]);
+        let e = finite_field("f", &rec, 2, 0, "t").unwrap_err().to_string();
+        assert!(
+            e.starts_with("f line 2, column 1 (t): t \"9999")
+                && e.ends_with("is 2000 bytes long: a number field may hold at most 1024"),
+            "{e}"
+        );
+        let e = finite_field("f", &rec, 2, 1, "x").unwrap_err().to_string();
+        assert!(
+            e.contains("\"xxxxx") && e.contains("... (500 bytes) is not a number"),
+            "{e}"
+        );
+        assert!(e.len() < 200, "{e}");
+        let names = vec!["q".repeat(10_000); 3];
+        let h = Header::new(&ByteRecord::from(names), 1);
+        let e = h.require("f", &["t", "x", "z"]).unwrap_err().to_string();
+        assert!(e.len() < 400 && e.ends_with("(30002 bytes in all))"), "{e}");
+    }
+
+    #[test]
+    fn records_know_their_line_whatever_the_line_ends() {
+        for text in [
+            "h\n1\n\n2\n",
+            "h\r\n1\r\n\r\n2\r\n",
+            "h\r1\r\r2\r",
+            "h\n1\n\n2",
+        ] {
+            let mut csv = csv_reader(text.as_bytes());
+            let mut rec = ByteRecord::new();
+            let mut lines = Vec::new();
+            while let Some(l) = next_record("f", &mut csv, &mut rec).unwrap() {
+                lines.push((l, rec.get(0).unwrap().to_vec()));
+            }
+            assert_eq!(
+                lines,
+                vec![(1, b"h".to_vec()), (2, b"1".to_vec()), (4, b"2".to_vec())],
+                "{text:?}"
+            );
+        }
     }
 
     #[test]

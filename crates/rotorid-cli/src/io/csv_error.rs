@@ -4,8 +4,34 @@
 //!
 //! Display: `FILE line L, column C (NAME): MESSAGE`, dropping the parts that do not apply
 //! (`FILE: MESSAGE` for an empty file, `FILE line L: MESSAGE` for a short row).
+//!
+//! A message quotes at most a short prefix of what it complains about ([`quote`],
+//! [`abbreviate`]): a bad field of a megabyte, or a header of NUL bytes, must not flood
+//! the terminal.
 
 use std::fmt;
+
+/// Most characters of a value that a message quotes.
+pub const QUOTE_CHARS: usize = 40;
+
+/// `raw` quoted for a message (Rust string syntax, control characters escaped): whole if
+/// it has at most [`QUOTE_CHARS`] characters, else its first ones followed by `...` and its
+/// length in bytes.
+pub fn quote(raw: &[u8]) -> String {
+    let text = String::from_utf8_lossy(raw);
+    match text.char_indices().nth(QUOTE_CHARS) {
+        None => format!("{text:?}"),
+        Some((cut, _)) => format!("{:?}... ({} bytes)", &text[..cut], raw.len()),
+    }
+}
+
+/// `text` cut to at most `max_chars` characters, with `... (N bytes in all)` when cut.
+pub fn abbreviate(text: &str, max_chars: usize) -> String {
+    match text.char_indices().nth(max_chars) {
+        None => text.to_owned(),
+        Some((cut, _)) => format!("{}... ({} bytes in all)", &text[..cut], text.len()),
+    }
+}
 
 /// A CSV input that cannot be used, and where.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,6 +100,36 @@ impl fmt::Display for CsvError {
 
 impl std::error::Error for CsvError {}
 
+/// The payload of every `io::Error` an output ([`super::Output`]) returns: it remembers
+/// which output failed, so that a write error a reader meets (the output is flushed before
+/// each read of the input, see [`super::FlushBeforeRead`]) is reported against the output,
+/// not the input. Its `Display` is the underlying error's, so `cannot write NAME: {e}`
+/// reads as for a plain I/O error.
+#[derive(Debug)]
+pub struct WriteFailure {
+    /// The output's name as given (`-` for stdout).
+    pub output: String,
+    message: String,
+}
+
+impl WriteFailure {
+    /// The failure of `output`, described by `message`.
+    pub fn new(output: &str, message: &str) -> Self {
+        Self {
+            output: output.to_owned(),
+            message: message.to_owned(),
+        }
+    }
+}
+
+impl fmt::Display for WriteFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for WriteFailure {}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -89,5 +145,16 @@ mod tests {
             CsvError::field("a.csv", 7, 2, "z", "bad").to_string(),
             "a.csv line 7, column 3 (z): bad"
         );
+    }
+
+    #[test]
+    fn quotes_are_short() {
+        assert_eq!(quote(b"abc"), "\"abc\"");
+        let long = vec![0u8; 1 << 20];
+        let q = quote(&long);
+        assert!(q.ends_with("... (1048576 bytes)"), "{q}");
+        assert!(q.len() < 250, "{q}");
+        assert_eq!(abbreviate("t,x,z", 10), "t,x,z");
+        assert_eq!(abbreviate("abcdef", 3), "abc... (6 bytes in all)");
     }
 }

@@ -22,7 +22,8 @@ use std::io::{self, Read, Write};
 use csv::ByteRecord;
 
 use super::columns::{
-    check_length, csv_reader, finite_field, number_field, optional_field, read_error, Header,
+    check_length, csv_reader, finite_field, next_record, number_field, optional_field, CsvReader,
+    Header,
 };
 use super::csv_error::CsvError;
 use super::number::write_row;
@@ -98,7 +99,7 @@ impl<W: Write> EstimatesWriter<W> {
 /// fields empty, `NaN` (both `None`) or a number; rcond a number.
 pub struct EstimatesReader<R: Read> {
     file: String,
-    csv: csv::Reader<R>,
+    csv: CsvReader<R>,
     header: Header,
     cols: Vec<usize>,
     rec: ByteRecord,
@@ -109,10 +110,7 @@ impl<R: Read> EstimatesReader<R> {
     pub fn new(file: &str, input: R) -> Result<Self, CsvError> {
         let mut csv = csv_reader(input);
         let mut rec = ByteRecord::new();
-        if !csv
-            .read_byte_record(&mut rec)
-            .map_err(|e| read_error(file, e))?
-        {
+        let Some(line) = next_record(file, &mut csv, &mut rec)? else {
             return Err(CsvError::file(
                 file,
                 format!(
@@ -120,8 +118,8 @@ impl<R: Read> EstimatesReader<R> {
                     ESTIMATES_HEADER.join(",")
                 ),
             ));
-        }
-        let header = Header::new(&rec, rec.position().map_or(1, |p| p.line()));
+        };
+        let header = Header::new(&rec, line);
         let cols = header.require(file, &ESTIMATES_HEADER)?;
         Ok(Self {
             file: file.to_owned(),
@@ -135,14 +133,9 @@ impl<R: Read> EstimatesReader<R> {
     /// The next row, or `None` at the end.
     pub fn next_row(&mut self) -> Result<Option<EstimateRow>, CsvError> {
         let f = self.file.as_str();
-        if !self
-            .csv
-            .read_byte_record(&mut self.rec)
-            .map_err(|e| read_error(f, e))?
-        {
+        let Some(line) = next_record(f, &mut self.csv, &mut self.rec)? else {
             return Ok(None);
-        }
-        let line = self.rec.position().map_or(0, |p| p.line());
+        };
         check_length(f, &self.rec, line, &self.header)?;
         let c = &self.cols;
         let rec = &self.rec;

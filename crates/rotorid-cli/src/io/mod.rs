@@ -17,6 +17,7 @@ pub mod columns;
 pub mod csv_error;
 pub mod estimates_csv;
 pub mod identified;
+pub mod lines;
 pub mod number;
 pub mod output;
 pub mod params;
@@ -26,7 +27,7 @@ pub mod scenario;
 
 pub use csv_error::CsvError;
 pub use estimates_csv::{EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES_HEADER};
-pub use output::{is_broken_pipe, open_input, FileMode, Output};
+pub use output::{check_distinct_files, is_broken_pipe, open_input, FileMode, Output};
 pub use params::ParameterSet;
 pub use response_csv::{ResponseReader, ResponseWriter};
 pub use scenario::{LoadScenario, ScenarioSpec, SimulationOverrides, Truth};

@@ -12,7 +12,12 @@
 //! ```
 //!
 //! Both branches are exact round trips, so the choice only affects length and readability.
+//!
+//! Numbers in messages go through [`readable`]: the same text, with an exponent written as
+//! `1.0e300` (a decimal point in the mantissa), so a huge or tiny value is never printed
+//! as 300 digits and never mistaken for an integer.
 
+use std::fmt;
 use std::io::{self, Write};
 
 /// Append the shortest round-trip text of `v` to `out` (see the module doc for the format).
@@ -36,6 +41,29 @@ pub fn format_f64(v: f64) -> String {
     let mut buf = Vec::with_capacity(24);
     push_f64(&mut buf, v);
     String::from_utf8(buf).expect("number text is ASCII")
+}
+
+/// `v` for a message: the shortest round-trip text, with an exponent beyond
+/// 1e-4 <= |v| < 1e15 and a decimal point in its mantissa (`14.29`, `1.0e300`, `-2.5e-7`,
+/// `inf`, `NaN`). Use it as `format!("t = {} s", readable(t))`.
+pub fn readable(v: f64) -> Readable {
+    Readable(v)
+}
+
+/// The [`fmt::Display`] of [`readable`].
+#[derive(Debug, Clone, Copy)]
+pub struct Readable(pub f64);
+
+impl fmt::Display for Readable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut buf = Vec::with_capacity(24);
+        push_f64(&mut buf, self.0);
+        let text = String::from_utf8_lossy(&buf);
+        match text.split_once('e') {
+            Some((mantissa, exp)) if !mantissa.contains('.') => write!(f, "{mantissa}.0e{exp}"),
+            _ => f.write_str(&text),
+        }
+    }
 }
 
 /// `v` with `sig` significant digits for people (not a round trip): fixed notation for
@@ -167,6 +195,17 @@ mod tests {
         assert_eq!(format_f64(2e15), "2e15");
         assert_eq!(format_f64(f64::NAN), "NaN");
         assert_eq!(format_f64(f64::NEG_INFINITY), "-inf");
+    }
+
+    #[test]
+    fn messages_never_spell_out_huge_numbers() {
+        assert_eq!(readable(1e300).to_string(), "1.0e300");
+        assert_eq!(readable(-2.5e-7).to_string(), "-2.5e-7");
+        assert_eq!(readable(14.29).to_string(), "14.29");
+        assert_eq!(readable(0.0).to_string(), "0");
+        assert_eq!(readable(f64::MAX).to_string(), "1.7976931348623157e308");
+        assert_eq!(readable(f64::INFINITY).to_string(), "inf");
+        assert_eq!(readable(f64::NAN).to_string(), "NaN");
     }
 
     #[test]

@@ -1,22 +1,125 @@
-//! A progress bar on stderr for long runs: shown only when stderr is a terminal and the run
-//! has at least [`PROGRESS_MIN_STEPS`] steps, so pipes, logs and tests never see it.
+//! Progress of long runs on stderr, so that a run of minutes is never silent:
+//!
+//! - stderr a terminal: a bar, drawn once the run has taken [`FIRST_REPORT_AFTER`];
+//! - otherwise (a log file, a pipe, CI): a line such as
+//!   `simulate (exact): 40% (4000 of 10000 samples), 12 s elapsed` once the run has taken
+//!   [`FIRST_REPORT_AFTER`], then at each further tenth of the run and at least every
+//!   [`LINE_INTERVAL`].
+//!
+//! Short runs print nothing, whatever their length in steps: what matters to the person
+//! waiting is time (a 1e8 rad/s^2 ramp needs minutes for a few thousand samples).
 
 use std::io::IsTerminal as _;
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-/// Runs shorter than this (in steps) get no progress bar.
-pub const PROGRESS_MIN_STEPS: u64 = 500_000;
+/// Nothing is shown before a run has taken this long.
+pub const FIRST_REPORT_AFTER: Duration = Duration::from_secs(2);
 
-/// Steps between two updates of the bar (updates are cheap, but not free per sample).
-pub const PROGRESS_STRIDE: u64 = 1 << 14;
+/// Without a terminal, at most this long between two lines.
+pub const LINE_INTERVAL: Duration = Duration::from_secs(10);
 
-/// A bar for `total` steps labelled `what`, hidden unless stderr is a terminal and
-/// `total >= PROGRESS_MIN_STEPS`.
-pub fn progress_bar(total: u64, what: &str) -> ProgressBar {
-    if total < PROGRESS_MIN_STEPS || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
+/// Steps between two looks at the clock (a step of the fastest integrator takes tens of
+/// nanoseconds, a clock read about as long).
+const CHECK_STRIDE: u64 = 64;
+
+enum Shown {
+    /// Not yet decided (before [`FIRST_REPORT_AFTER`]).
+    Nothing,
+    Bar(ProgressBar),
+    Lines {
+        last: Instant,
+        tenth: u64,
+    },
+}
+
+/// The progress of one run of `total` steps (module doc).
+pub struct Progress {
+    what: String,
+    total: u64,
+    terminal: bool,
+    start: Instant,
+    next_check: u64,
+    shown: Shown,
+}
+
+impl Progress {
+    /// Progress of `total` steps labelled `what` (e.g. `simulate (exact)`).
+    pub fn new(total: u64, what: &str) -> Self {
+        Self::with_terminal(total, what, std::io::stderr().is_terminal())
     }
+
+    fn with_terminal(total: u64, what: &str, terminal: bool) -> Self {
+        Self {
+            what: what.to_owned(),
+            total: total.max(1),
+            terminal,
+            start: Instant::now(),
+            next_check: CHECK_STRIDE,
+            shown: Shown::Nothing,
+        }
+    }
+
+    /// `done` steps are done. Cheap: looks at the clock every [`CHECK_STRIDE`] steps.
+    pub fn update(&mut self, done: u64) {
+        if done < self.next_check {
+            return;
+        }
+        self.next_check = done + CHECK_STRIDE;
+        if let Some(line) = self.report(done, Instant::now()) {
+            eprintln!("{line}");
+        }
+    }
+
+    /// The line to print now, if any (without a terminal), else drive the bar.
+    fn report(&mut self, done: u64, now: Instant) -> Option<String> {
+        let elapsed = now.saturating_duration_since(self.start);
+        let tenth = done.min(self.total) * 10 / self.total;
+        match &mut self.shown {
+            Shown::Nothing if elapsed < FIRST_REPORT_AFTER => None,
+            Shown::Nothing if self.terminal => {
+                self.shown = Shown::Bar(bar(self.total, &self.what, done));
+                None
+            }
+            Shown::Nothing => {
+                self.shown = Shown::Lines { last: now, tenth };
+                Some(self.line(done, elapsed))
+            }
+            Shown::Bar(pb) => {
+                pb.set_position(done);
+                None
+            }
+            Shown::Lines { last, tenth: shown } => {
+                if tenth > *shown || now.saturating_duration_since(*last) >= LINE_INTERVAL {
+                    (*last, *shown) = (now, tenth);
+                    Some(self.line(done, elapsed))
+                } else {
+                    None
+                }
+            }
+        }
+    }
+
+    fn line(&self, done: u64, elapsed: Duration) -> String {
+        format!(
+            "{}: {}% ({done} of {} samples), {} s elapsed",
+            self.what,
+            done.min(self.total) * 100 / self.total,
+            self.total,
+            elapsed.as_secs()
+        )
+    }
+
+    /// The run is over: clear the bar (lines stay).
+    pub fn finish(self) {
+        if let Shown::Bar(pb) = self.shown {
+            pb.finish_and_clear();
+        }
+    }
+}
+
+fn bar(total: u64, what: &str, done: u64) -> ProgressBar {
     let pb = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
     let style = ProgressStyle::with_template(
         "{msg} [{bar:40}] {human_pos}/{human_len} samples, {elapsed} elapsed, eta {eta}",
@@ -25,5 +128,39 @@ pub fn progress_bar(total: u64, what: &str) -> ProgressBar {
     .unwrap_or_else(|_| ProgressStyle::default_bar());
     pb.set_style(style);
     pb.set_message(what.to_owned());
+    pb.set_position(done);
     pb
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_after_a_while_then_per_tenth_or_interval() {
+        let mut p = Progress::with_terminal(1000, "simulate (exact)", false);
+        let t0 = p.start;
+        let at = |s: u64| t0 + Duration::from_millis(s);
+        assert_eq!(p.report(100, at(1000)), None, "too early");
+        assert_eq!(
+            p.report(250, at(2500)).as_deref(),
+            Some("simulate (exact): 25% (250 of 1000 samples), 2 s elapsed")
+        );
+        assert_eq!(p.report(290, at(3000)), None, "same tenth");
+        assert!(p.report(300, at(3100)).unwrap().contains("30%"));
+        assert_eq!(p.report(301, at(4000)), None);
+        assert!(p.report(302, at(13_200)).unwrap().contains("13 s elapsed"));
+        assert!(p.report(1000, at(13_300)).unwrap().contains("100%"));
+    }
+
+    #[test]
+    fn quick_runs_and_terminals_print_no_lines() {
+        let mut p = Progress::with_terminal(10, "x", false);
+        assert_eq!(p.report(10, p.start), None);
+        let mut p = Progress::with_terminal(10, "x", true);
+        let later = p.start + Duration::from_secs(5);
+        assert_eq!(p.report(5, later), None);
+        assert!(matches!(p.shown, Shown::Bar(_)));
+        p.finish();
+    }
 }

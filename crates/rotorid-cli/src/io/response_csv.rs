@@ -27,7 +27,7 @@ use std::io::{self, Read, Write};
 use csv::ByteRecord;
 use rotorid::SpeedState;
 
-use super::columns::{check_length, csv_reader, finite_field, read_error, Header};
+use super::columns::{check_length, csv_reader, finite_field, next_record, CsvReader, Header};
 use super::csv_error::CsvError;
 use super::number::write_row;
 
@@ -91,7 +91,7 @@ pub struct ResponseRow {
 /// state, so it reads a live pipe of any length (see the module doc for the rules).
 pub struct ResponseReader<R: Read> {
     file: String,
-    csv: csv::Reader<R>,
+    csv: CsvReader<R>,
     header: Header,
     txz: [usize; 3],
     phi: Option<[usize; 3]>,
@@ -104,17 +104,13 @@ impl<R: Read> ResponseReader<R> {
     pub fn new(file: &str, input: R) -> Result<Self, CsvError> {
         let mut csv = csv_reader(input);
         let mut rec = ByteRecord::new();
-        let found = csv
-            .read_byte_record(&mut rec)
-            .map_err(|e| read_error(file, e))?;
-        if !found {
+        let Some(line) = next_record(file, &mut csv, &mut rec)? else {
             return Err(CsvError::file(
                 file,
                 "the file is empty: expected a header line naming at least t,x,z, then one \
                  row per sample",
             ));
-        }
-        let line = rec.position().map_or(1, |p| p.line());
+        };
         let header = Header::new(&rec, line);
         let txz = header.require(file, &["t", "x", "z"])?;
         let phis = [
@@ -162,14 +158,9 @@ impl<R: Read> ResponseReader<R> {
     /// The next validated row, or `None` at the end of the input.
     pub fn next_row(&mut self) -> Result<Option<ResponseRow>, CsvError> {
         let f = self.file.as_str();
-        let found = self
-            .csv
-            .read_byte_record(&mut self.rec)
-            .map_err(|e| read_error(f, e))?;
-        if !found {
+        let Some(line) = next_record(f, &mut self.csv, &mut self.rec)? else {
             return Ok(None);
-        }
-        let line = self.rec.position().map_or(0, |p| p.line());
+        };
         check_length(f, &self.rec, line, &self.header)?;
         let field = |col: usize, name: &str| finite_field(f, &self.rec, line, col, name);
         let [ct, cx, cz] = self.txz;

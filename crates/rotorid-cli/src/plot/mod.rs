@@ -6,7 +6,8 @@
 //! ([`scale`]: NaN and masked points ignored, optional limits around a reference),
 //! engineering tick labels ([`ticks`]) and a legend beside the axes. Lines are clipped to
 //! the axes ([`geometry`]) and decimated to the pixel grid, so a spike cannot paint over
-//! the margins and a long record still makes a small SVG.
+//! the margins and a long record still makes a small SVG; a record read from a file is
+//! thinned to the pixel grid as it streams in ([`thin`]), so memory stays flat too.
 //!
 //! [`save`] picks the format from the file extension (`.png` or `.svg`). Text uses the
 //! embedded DejaVu Sans ([`font`]).
@@ -20,11 +21,15 @@ pub mod geometry;
 pub mod polar;
 mod render;
 pub mod scale;
+pub mod thin;
 pub mod ticks;
 
+use std::io::Write as _;
 use std::path::Path;
 
 use anyhow::{bail, Context};
+
+use crate::io::{FileMode, Output};
 
 /// Default image size in pixels (width, height): at least 1200 x 800.
 pub const DEFAULT_SIZE: (u32, u32) = (1400, 900);
@@ -290,7 +295,8 @@ impl ImageFormat {
     }
 }
 
-/// Write `fig` to `path` as PNG or SVG according to the extension.
+/// Write `fig` to `path` as PNG or SVG according to the extension, atomically (a failed
+/// run leaves no half image; see [`crate::io::output`]).
 pub fn save(fig: &Figure, path: &Path) -> anyhow::Result<()> {
     let format = ImageFormat::from_path(path)?;
     if fig.panels.is_empty() || fig.panels.len() > 4 {
@@ -317,6 +323,13 @@ pub fn save(fig: &Figure, path: &Path) -> anyhow::Result<()> {
         }
     }
     font::ensure_registered()?;
-    render::render(fig, path, format)
+    let bytes = render::render(fig, format)
+        .with_context(|| format!("cannot draw figure {}", path.display()))?;
+    let name = path.to_string_lossy();
+    let mut out = Output::create(&name, FileMode::Atomic)
+        .with_context(|| format!("cannot write figure {}", path.display()))?;
+    out.write_all(&bytes)
+        .with_context(|| format!("cannot write figure {}", path.display()))?;
+    out.commit()
         .with_context(|| format!("cannot write figure {}", path.display()))
 }

@@ -15,8 +15,6 @@
 //! which antialiases the lines (plotters' bitmap lines are aliased) and evens out the
 //! 1-pixel glyph placement of its text renderer.
 
-use std::path::Path;
-
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -98,8 +96,8 @@ fn font(px: u32) -> TextStyle<'static> {
     (FAMILY, px).into_font().color(&BLACK)
 }
 
-/// Render `fig` to `path` in `format` (the caller has checked the path and extension).
-pub(super) fn render(fig: &Figure, path: &Path, format: ImageFormat) -> anyhow::Result<()> {
+/// Render `fig` in `format`: the bytes of the PNG or SVG file.
+pub(super) fn render(fig: &Figure, format: ImageFormat) -> anyhow::Result<Vec<u8>> {
     let (w, h) = fig.size;
     match format {
         ImageFormat::Png => {
@@ -112,16 +110,31 @@ pub(super) fn render(fig: &Figure, path: &Path, format: ImageFormat) -> anyhow::
                 root.present().map_err(de)?;
             }
             let small = box_downsample(&big, bw, bh, s);
-            let mut out = BitMapBackend::new(path, (w, h));
-            out.blit_bitmap((0, 0), (w, h), &small).map_err(de)?;
-            out.present().map_err(de)
+            drop(big);
+            encode_png(&small, w, h)
         }
         ImageFormat::Svg => {
-            let root = SVGBackend::new(path, (w, h)).into_drawing_area();
-            draw_figure(fig, &root, Px::scaled(1))?;
-            root.present().map_err(de)
+            let mut text = String::new();
+            {
+                let root = SVGBackend::with_string(&mut text, (w, h)).into_drawing_area();
+                draw_figure(fig, &root, Px::scaled(1))?;
+                root.present().map_err(de)?;
+            }
+            Ok(text.into_bytes())
         }
     }
+}
+
+/// An 8-bit RGB image of `w x h` pixels as a PNG file.
+fn encode_png(rgb: &[u8], w: u32, h: u32) -> anyhow::Result<Vec<u8>> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header()?;
+    writer.write_image_data(rgb)?;
+    writer.finish()?;
+    Ok(out)
 }
 
 /// Average an RGB image of `bw x bh` pixels over `s x s` blocks (module doc).

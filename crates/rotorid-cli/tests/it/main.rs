@@ -3,7 +3,6 @@
 mod common;
 
 mod analysis;
-
 mod demo;
 mod golden;
 mod identify;
@@ -11,5 +10,6 @@ mod modulating;
 mod paper;
 mod plot;
 mod refine;
+mod safety;
 mod scenario;
 mod simulate;

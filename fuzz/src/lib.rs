@@ -1,0 +1,71 @@
+//! What the fuzz targets share: the CLI's CSV readers, compiled from their sources (the
+//! CLI is a binary crate), and a decoder of fuzz input into f64 values.
+//!
+//! The reader modules are included as they are in `crates/rotorid-cli/src/io/`, at this
+//! crate's root, so their `super::` paths resolve here.
+
+#![allow(dead_code, unused_imports)]
+
+#[path = "../../crates/rotorid-cli/src/io/columns.rs"]
+pub mod columns;
+#[path = "../../crates/rotorid-cli/src/io/csv_error.rs"]
+pub mod csv_error;
+#[path = "../../crates/rotorid-cli/src/io/estimates_csv.rs"]
+pub mod estimates_csv;
+#[path = "../../crates/rotorid-cli/src/io/lines.rs"]
+pub mod lines;
+#[path = "../../crates/rotorid-cli/src/io/number.rs"]
+pub mod number;
+#[path = "../../crates/rotorid-cli/src/io/params.rs"]
+pub mod params;
+#[path = "../../crates/rotorid-cli/src/io/response_csv.rs"]
+pub mod response_csv;
+
+/// Reads fuzz input as a sequence of values, never running dry (zeros after the end).
+pub struct Values<'a> {
+    data: &'a [u8],
+}
+
+impl<'a> Values<'a> {
+    /// Values from `data`.
+    pub fn new(data: &'a [u8]) -> Self {
+        Self { data }
+    }
+
+    /// True when every byte has been used.
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+
+    /// The next byte (0 after the end).
+    pub fn byte(&mut self) -> u8 {
+        match self.data.split_first() {
+            Some((b, rest)) => {
+                self.data = rest;
+                *b
+            }
+            None => 0,
+        }
+    }
+
+    /// The next f64: a tag byte picks a raw bit pattern (any NaN, infinity, subnormal),
+    /// a small integer, or a value of ordinary magnitude, so both the edges and the
+    /// ordinary paths are reached.
+    pub fn f64(&mut self) -> f64 {
+        match self.byte() % 4 {
+            0 => {
+                let mut b = [0u8; 8];
+                for x in &mut b {
+                    *x = self.byte();
+                }
+                f64::from_le_bytes(b)
+            }
+            1 => f64::from(self.byte() as i8),
+            _ => {
+                let m = f64::from(u16::from_le_bytes([self.byte(), self.byte()])) / 65536.0;
+                let e = i32::from(self.byte() as i8 % 16);
+                (m - 0.5) * 2f64.powi(e)
+            }
+        }
+    }
+}
