@@ -4,9 +4,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use rotorid::identify::{
-    AlgebraicIdentifier, IdentifierConfig, Known, Measurement, Quadrature, SpeedModel,
-};
+use rotorid::identify::algebraic::{AlgebraicConfig, AlgebraicIdentifier, Quadrature, SpeedModel};
+use rotorid::identify::{Known, Measurement};
 use rotorid::SpeedState;
 use rotorid_fuzz::Values;
 
@@ -31,7 +30,7 @@ fuzz_target!(|data: &[u8]| {
             phi0: v.f64(),
         }
     };
-    let config = IdentifierConfig {
+    let config = AlgebraicConfig {
         quadrature,
         rcond_min: v.f64().abs().min(1.0),
         speed_model,

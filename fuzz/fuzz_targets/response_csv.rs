@@ -9,7 +9,7 @@ use std::io::Read as _;
 use libfuzzer_sys::fuzz_target;
 use rotorid_fuzz::estimates_csv::EstimatesReader;
 use rotorid_fuzz::lines::LineReader;
-use rotorid_fuzz::response_csv::{ResponseReader, DEFAULT_TIME_TOLERANCE};
+use rotorid_fuzz::response_csv::ResponseReader;
 
 fuzz_target!(|data: &[u8]| {
     // the line reader alone, with a small cap and buffer: it hands out exactly the
@@ -29,7 +29,7 @@ fuzz_target!(|data: &[u8]| {
             }
         }
     }
-    match ResponseReader::new("f.csv", data, DEFAULT_TIME_TOLERANCE) {
+    match ResponseReader::new("f.csv", data) {
         Ok(mut r) => {
             let mut last_line = 1;
             loop {

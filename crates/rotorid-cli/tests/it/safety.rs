@@ -86,37 +86,49 @@ struct Measured {
     peak_kib: i64,
 }
 
-/// Run `cmd` to its end, collecting its output and its peak resident set (`ru_maxrss`
-/// of `wait4`, exact: the kernel's own high-water mark).
-#[expect(
-    clippy::zombie_processes,
-    reason = "reaped by wait4, which also gives the peak"
-)]
+/// Run `cmd` to its end, collecting its output and its peak resident set. The peak is
+/// `ru_maxrss` of `wait4`, taken by a small Python parent that forks and execs `cmd`:
+/// measured from this (large, multi-test) process directly, the child's figure would
+/// start from this process's own high-water mark, which Linux records at exec.
 fn measured(cmd: &mut Command) -> Measured {
-    let mut child = cmd
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = child.stdout.take().unwrap();
-    let mut err = child.stderr.take().unwrap();
-    let t_out = std::thread::spawn(move || {
-        let mut v = Vec::new();
-        out.read_to_end(&mut v).unwrap();
-        v
-    });
-    let t_err = std::thread::spawn(move || {
-        let mut v = Vec::new();
-        err.read_to_end(&mut v).unwrap();
-        v
-    });
-    let (status, peak_kib) = wait4(child.id());
-    let stderr = String::from_utf8_lossy(&t_err.join().unwrap()).into_owned();
+    const PARENT: &str = "import os, sys\n\
+pid = os.fork()\n\
+if pid == 0:\n    os.execv(sys.argv[1], sys.argv[1:])\n\
+_, status, ru = os.wait4(pid, 0)\n\
+sys.stderr.write('\\nPEAK_KIB %d\\n' % ru.ru_maxrss)\n\
+sys.stderr.flush()\n\
+os._exit(128 + os.WTERMSIG(status) if os.WIFSIGNALED(status) else os.WEXITSTATUS(status))\n";
+    let mut wrapped = Command::new("python3");
+    wrapped
+        .arg("-c")
+        .arg(PARENT)
+        .arg(cmd.get_program())
+        .args(cmd.get_args());
+    for (k, v) in cmd.get_envs() {
+        match v {
+            Some(v) => wrapped.env(k, v),
+            None => wrapped.env_remove(k),
+        };
+    }
+    if let Some(d) = cmd.get_current_dir() {
+        wrapped.current_dir(d);
+    }
+    let out = wrapped.stdin(Stdio::null()).output().unwrap();
+    let mut stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    let peak_kib = match stderr.rfind("\nPEAK_KIB ") {
+        Some(i) => {
+            let v = stderr[i + 10..].trim().parse().unwrap();
+            stderr.truncate(i);
+            v
+        }
+        None => panic!("no peak reported: {stderr}"),
+    };
     assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    let code = out.status.code().unwrap_or(-1);
     Measured {
-        ok: libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
-        signal: libc::WIFSIGNALED(status).then(|| libc::WTERMSIG(status)),
-        stdout: t_out.join().unwrap(),
+        ok: code == 0,
+        signal: (code > 128).then_some(code - 128),
+        stdout: out.stdout,
         stderr,
         peak_kib,
     }

@@ -129,6 +129,19 @@ pub enum Finding {
         /// The residual's dominant frequency \[Hz\].
         dominant_frequency_hz: Option<f64>,
     },
+    /// An estimate outside the model's physical range (m or k <= 0, c < 0): withheld.
+    NotPhysical {
+        /// The parameter.
+        parameter: crate::Parameter,
+        /// Its estimate \[its unit\].
+        value: f64,
+    },
+    /// Algebraic estimates that settle only late in the record, never, or outside the
+    /// physical range: the identifier's integrals amplify noise as the record grows.
+    AlgebraicUnsettled {
+        /// The parameters concerned.
+        parameters: Vec<crate::Parameter>,
+    },
     /// The Cramer-Rao bound could not be computed.
     CrbUnavailable {
         /// Why.
@@ -262,6 +275,21 @@ fn message(f: &Finding) -> String {
             dominant_frequency_hz.map_or(String::new(), |f| format!(
                 "; dominant residual frequency {f:.1} Hz"
             ))
+        ),
+        Finding::NotPhysical { parameter, value } => format!(
+            "{parameter} = {value:.4e} {} is not physical (m and k must be > 0, c >= 0): \
+             withheld",
+            parameter.unit()
+        ),
+        Finding::AlgebraicUnsettled { parameters } => format!(
+            "the algebraic estimates of {} never settled in the first half of the record (or \
+             are not physical): its iterated integrals amplify noise as the record grows, so \
+             on noisy data its late values are noise; use --method modulating or refine",
+            parameters
+                .iter()
+                .map(|p| p.name())
+                .collect::<Vec<_>>()
+                .join(", ")
         ),
         Finding::CrbUnavailable { reason } => {
             format!("the Cramer-Rao bound was not computed: {reason}")

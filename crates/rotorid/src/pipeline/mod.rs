@@ -136,7 +136,7 @@ fn per_direction(
         .iter()
         .enumerate()
         .map(|(i, &p)| {
-            let determined = ok[i / 3] && values[i].is_finite();
+            let determined = ok[i / 3] && values[i].is_finite() && physical(p, values[i]);
             let value = determined.then_some(values[i]);
             let truth = k.truth_of(p);
             let mut r = ParameterResult {
@@ -149,6 +149,31 @@ fn per_direction(
             };
             fill(i, &mut r);
             r
+        })
+        .collect()
+}
+
+/// Inside the model's physical range: m, k > 0, c >= 0.
+pub(crate) fn physical(p: Parameter, v: f64) -> bool {
+    match p.physical() {
+        Parameter::M | Parameter::Kx | Parameter::Kz => v > 0.0,
+        Parameter::Cx | Parameter::Cz => v >= 0.0,
+        _ => true,
+    }
+}
+
+/// One diagnostic per estimate outside the physical range (withheld).
+fn unphysical(params: &[ParameterResult]) -> Vec<Diagnostic> {
+    params
+        .iter()
+        .filter_map(|r| {
+            let v = r.estimate?;
+            (!physical(r.parameter, v)).then(|| {
+                Diagnostic::new(Finding::NotPhysical {
+                    parameter: r.parameter,
+                    value: v,
+                })
+            })
         })
         .collect()
 }
@@ -184,8 +209,26 @@ fn algebraic_identification(
     ];
     let parameters = per_direction(k, values, ok, |i, r| {
         r.t_s = results[i].final_t;
-        r.identification_time_s = results[i].identification_time;
+        // an estimate outside the physical range never counts as converged
+        r.identification_time_s = results[i].identification_time.filter(|_| r.determined);
     });
+    let mut diagnostics = unphysical(&parameters);
+    // Settled only in the last half of the record, or never: the iterated integrals amplify
+    // the noise as the record grows (docs/method.md section 3.8).
+    let half = record.t_first_s + 0.5 * (record.t_last_s - record.t_first_s);
+    let unsettled: Vec<Parameter> = parameters
+        .iter()
+        .filter(|r| {
+            !r.determined && r.estimate.is_some()
+                || r.determined && r.identification_time_s.is_none_or(|t| t > half)
+        })
+        .map(|r| r.parameter)
+        .collect();
+    if !unsettled.is_empty() {
+        diagnostics.push(Diagnostic::new(Finding::AlgebraicUnsettled {
+            parameters: unsettled,
+        }));
+    }
     Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Algebraic,
@@ -197,7 +240,7 @@ fn algebraic_identification(
         covariance: None,
         noise: None,
         adequacy: None,
-        diagnostics: Vec::new(),
+        diagnostics,
         algebraic: Some(AlgebraicDetail {
             quadrature: s.quadrature,
             rcond_min: s.rcond_min,
@@ -252,7 +295,7 @@ fn modulating_identification(
             r.t_s = Some(e.t);
         }
     });
-    let diagnostics = [(Direction::X, e.x), (Direction::Z, e.z)]
+    let mut diagnostics: Vec<Diagnostic> = [(Direction::X, e.x), (Direction::Z, e.z)]
         .iter()
         .filter(|(_, d)| !d.well_conditioned(rcond_min))
         .map(|&(direction, d)| {
@@ -267,6 +310,7 @@ fn modulating_identification(
             })
         })
         .collect();
+    diagnostics.extend(unphysical(&parameters));
     Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Modulating,
