@@ -198,9 +198,9 @@ impl RunningGrid {
         self.n == 0
     }
 
-    /// The fitted grid (snapped, module doc), `None` before two stamps; `max_deviation`
-    /// is 0 (a stream cannot revisit its stamps).
-    pub fn grid(&self) -> Option<TimeGrid> {
+    /// The least-squares fit as it stands, not snapped: (t0, dt) \[s\]; cheap enough to
+    /// check every stamp of a stream against.
+    pub fn fit(&self) -> Option<TimeGrid> {
         if self.n < 2 {
             return None;
         }
@@ -213,7 +213,22 @@ impl RunningGrid {
         if !(dt.is_finite() && dt > 0.0) {
             return None;
         }
-        let dt = snap_dt(dt);
+        Some(TimeGrid {
+            t0: self.first + (s_u - dt * s_i) / n,
+            dt,
+            fitted_over: self.n,
+            max_deviation: 0.0,
+        })
+    }
+
+    /// The fitted grid (snapped, module doc), `None` before two stamps; `max_deviation`
+    /// is 0 (a stream cannot revisit its stamps).
+    pub fn grid(&self) -> Option<TimeGrid> {
+        let raw = self.fit()?;
+        let n = self.n as f64;
+        let s_i = n * (n - 1.0) / 2.0;
+        let s_u = self.s_u.value();
+        let dt = snap_dt(raw.dt);
         let offset = (s_u - dt * s_i) / n;
         let t0 = if offset.abs() <= SNAP_T0 * dt {
             self.first

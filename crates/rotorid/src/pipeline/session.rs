@@ -272,7 +272,7 @@ impl Session {
                 // Check against the given grid, or the fit of every stamp so far.
                 let reference = match self.timing {
                     Timing::Grid { grid, .. } => Some(grid),
-                    Timing::Fit { .. } => self.running.grid(),
+                    Timing::Fit { .. } => self.running.fit(),
                 };
                 if let Some(g) = reference {
                     g.check(index, t, tolerance)?;
