@@ -208,6 +208,8 @@ mod tests {
             "z has 2 samples but t has 3: every column needs one value per sample"
         );
         let e = Columns::new(None, &a, &a, [Some(&a), Some(&a), Some(&b)]).unwrap_err();
-        assert!(e.to_string().starts_with("phi_ddot has 2 samples but x has 3"));
+        assert!(e
+            .to_string()
+            .starts_with("phi_ddot has 2 samples but x has 3"));
     }
 }

@@ -60,9 +60,11 @@ fn column<'py>(name: &str, obj: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray1
         })?;
     let untyped = converted.cast::<numpy::PyUntypedArray>()?;
     if untyped.ndim() != 1 {
+        let dims: Vec<String> = untyped.shape().iter().map(usize::to_string).collect();
+        let comma = if dims.len() == 1 { "," } else { "" };
         return Err(PyValueError::new_err(format!(
-            "{name}: expected a 1-D array (one value per sample), got shape {:?}",
-            untyped.shape()
+            "{name}: expected a 1-D array (one value per sample), got shape ({}{comma})",
+            dims.join(", ")
         )));
     }
     let contiguous = np.call_method1("ascontiguousarray", (converted,))?;
@@ -111,7 +113,11 @@ impl<'py> Held<'py> {
             opt(&self.t)?,
             slice(&self.x)?,
             slice(&self.z)?,
-            [opt(&self.speed[0])?, opt(&self.speed[1])?, opt(&self.speed[2])?],
+            [
+                opt(&self.speed[0])?,
+                opt(&self.speed[1])?,
+                opt(&self.speed[2])?,
+            ],
         )
         .map_err(py_err)
     }
@@ -307,9 +313,7 @@ fn simulate<'py>(
 #[pyfunction]
 fn read(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyDict>> {
     let path = path.to_string_lossy().into_owned();
-    let r = py
-        .detach(|| crate::response::read(&path))
-        .map_err(py_err)?;
+    let r = py.detach(|| crate::response::read(&path)).map_err(py_err)?;
     let d = PyDict::new(py);
     d.set_item("t", PyArray1::from_vec(py, r.t))?;
     d.set_item("x", PyArray1::from_vec(py, r.x))?;

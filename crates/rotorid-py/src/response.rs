@@ -225,8 +225,15 @@ mod tests {
 
     #[test]
     fn any_order_units_and_extra_columns() {
-        let r = parse("d.csv", "note,Z [m],t (s),x\nabc,2,0,1\nzz,4,0.5,3\n".as_bytes()).unwrap();
-        assert_eq!((r.t, r.x, r.z), (vec![0.0, 0.5], vec![1.0, 3.0], vec![2.0, 4.0]));
+        let r = parse(
+            "d.csv",
+            "note,Z [m],t (s),x\nabc,2,0,1\nzz,4,0.5,3\n".as_bytes(),
+        )
+        .unwrap();
+        assert_eq!(
+            (r.t, r.x, r.z),
+            (vec![0.0, 0.5], vec![1.0, 3.0], vec![2.0, 4.0])
+        );
         assert!(r.speed.is_none());
         let r = parse(
             "d.csv",

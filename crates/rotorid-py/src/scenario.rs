@@ -9,7 +9,9 @@ use std::io::Read as _;
 
 use rotorid::model::rad_per_s_to_rpm;
 use rotorid::pipeline::Knowledge;
-use rotorid::scenario_file::{ScenarioFileError, ScenarioSpec, SimulationOverrides, BUILTIN_TABLE1};
+use rotorid::scenario_file::{
+    ScenarioFileError, ScenarioSpec, SimulationOverrides, BUILTIN_TABLE1,
+};
 use rotorid::simulate::{add_noise, simulate as integrate, Method as Integration, TimeResponse};
 use rotorid::SpeedProfile;
 
@@ -201,11 +203,7 @@ impl Scenario {
 
     /// Its speed profile, if it states one.
     pub fn profile(&self) -> Result<Option<SpeedProfile>, Error> {
-        Ok(self
-            .spec
-            .identification()
-            .map_err(|e| self.error(e))?
-            .speed)
+        Ok(self.spec.identification().map_err(|e| self.error(e))?.speed)
     }
 
     /// The complete scenario a simulation needs, `ov` taking precedence.
@@ -362,7 +360,10 @@ mod tests {
             ..table1_keys()
         };
         let e = Scenario::from_keys(&both).unwrap_err().to_string();
-        assert!(e.starts_with("Scenario(): speed.rpm0 does not apply"), "{e}");
+        assert!(
+            e.starts_with("Scenario(): speed.rpm0 does not apply"),
+            "{e}"
+        );
         let partial = ScenarioKeys {
             a: None,
             ..table1_keys()
