@@ -38,4 +38,4 @@ export ROTORID_BIN="$target/release/rotorid"
 
 echo "== pytest"
 cd "$here"
-MPLBACKEND=Agg "$py" -m pytest -p no:cacheprovider tests "$@"
+"$py" -m pytest -p no:cacheprovider tests "$@"
