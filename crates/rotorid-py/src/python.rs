@@ -231,28 +231,7 @@ impl PyScenario {
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let k = self.inner.keys().map_err(py_err)?;
         let d = PyDict::new(py);
-        let keys = [
-            ("m", k.m),
-            ("cx", k.cx),
-            ("kx", k.kx),
-            ("cz", k.cz),
-            ("kz", k.kz),
-            ("a", k.a),
-            ("m_u", k.m_u),
-            ("d", k.d),
-            ("alpha_deg", k.alpha_deg),
-            ("rpm", k.rpm),
-            ("rpm0", k.rpm0),
-            ("accel", k.accel),
-            ("phi0_deg", k.phi0_deg),
-            ("dt", k.dt),
-            ("duration", k.duration),
-            ("x0", k.x0),
-            ("z0", k.z0),
-            ("vx0", k.vx0),
-            ("vz0", k.vz0),
-        ];
-        for (name, v) in keys {
+        for (name, v) in key_values(&k) {
             if let Some(v) = v {
                 d.set_item(name, v)?;
             }
@@ -261,8 +240,45 @@ impl PyScenario {
     }
 
     fn __repr__(&self) -> String {
-        format!("Scenario.load({:?})", self.inner.origin())
+        let origin = self.inner.origin();
+        if origin == rotorid::scenario_file::BUILTIN_TABLE1 {
+            return "Scenario.table1()".to_owned();
+        }
+        if !self.inner.from_keywords() {
+            return format!("Scenario.from_toml({origin:?})");
+        }
+        let k = self.inner.keys().unwrap_or_default();
+        let given: Vec<String> = key_values(&k)
+            .into_iter()
+            .filter_map(|(name, v)| Some(format!("{name}={:?}", v?)))
+            .collect();
+        format!("Scenario({})", given.join(", "))
     }
+}
+
+/// The keys by keyword name, in the order of `Scenario(...)`'s arguments.
+fn key_values(k: &ScenarioKeys) -> [(&'static str, Option<f64>); 19] {
+    [
+        ("m", k.m),
+        ("cx", k.cx),
+        ("kx", k.kx),
+        ("cz", k.cz),
+        ("kz", k.kz),
+        ("a", k.a),
+        ("m_u", k.m_u),
+        ("d", k.d),
+        ("alpha_deg", k.alpha_deg),
+        ("rpm", k.rpm),
+        ("rpm0", k.rpm0),
+        ("accel", k.accel),
+        ("phi0_deg", k.phi0_deg),
+        ("dt", k.dt),
+        ("duration", k.duration),
+        ("x0", k.x0),
+        ("z0", k.z0),
+        ("vx0", k.vx0),
+        ("vz0", k.vz0),
+    ]
 }
 
 /// Simulate `scenario`: a dict of arrays t, x, z, phi, phi_dot, phi_ddot.

@@ -191,6 +191,11 @@ impl Scenario {
         self.spec.origin()
     }
 
+    /// True when made from keyword arguments.
+    pub fn from_keywords(&self) -> bool {
+        self.keywords
+    }
+
     /// The library's parsed form.
     pub fn spec(&self) -> &ScenarioSpec {
         &self.spec

@@ -24,6 +24,10 @@ def test_scenarios_three_ways(tmp_path, table1):
     assert rig.to_dict() == {"a": 2.871, "m_u": 1e-4, "d": 0.15, "alpha_deg": 45.0,
                              "rpm": pytest.approx(1200), "phi0_deg": 0.0}
     assert rotorid.Scenario.load("table1").to_dict() == keys
+    assert repr(table1) == "Scenario.table1()"
+    assert repr(rig) == f"Scenario.from_toml({str(f)!r})".replace("'", '"')
+    assert repr(rotorid.Scenario(a=0.0, m_u=0.0, d=0.0, alpha_deg=0.0, kx=1e6)) == \
+        "Scenario(kx=1000000.0, a=0.0, m_u=0.0, d=0.0, alpha_deg=0.0)"
 
 
 def test_simulate_columns_and_overrides(table1):
