@@ -61,9 +61,8 @@ fn column<'py>(name: &str, obj: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray1
     let untyped = converted.cast::<numpy::PyUntypedArray>()?;
     if untyped.ndim() != 1 {
         let dims: Vec<String> = untyped.shape().iter().map(usize::to_string).collect();
-        let comma = if dims.len() == 1 { "," } else { "" };
         return Err(PyValueError::new_err(format!(
-            "{name}: expected a 1-D array (one value per sample), got shape ({}{comma})",
+            "{name}: expected a 1-D array (one value per sample), got shape ({})",
             dims.join(", ")
         )));
     }
