@@ -1,18 +1,31 @@
 """Type stubs of rotorid (SI units throughout; see the docstrings)."""
 
 import os
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping, Sequence, final
 
 import numpy as np
 import pandas as pd
 
 from ._result import Identification as Identification
 
+__all__ = [
+    "ESTIMATE_COLUMNS",
+    "METHODS",
+    "UNKNOWNS",
+    "Identification",
+    "Scenario",
+    "Session",
+    "identify",
+    "read",
+    "simulate",
+]
+
 __version__: str
 METHODS: list[str]
 UNKNOWNS: list[str]
 ESTIMATE_COLUMNS: list[str]
 
+@final
 class Scenario:
     """A scenario: the built-in table1, a TOML file, or the file's keys as keyword
     arguments: m [kg], cx, cz [N s/m], kx, kz [N/m], a [N s^2/m], m_u [kg], d [m],
@@ -20,8 +33,8 @@ class Scenario:
     [rad/s^2] (ramp), phi0_deg [deg]; dt, duration [s]; x0, z0 [m], vx0, vz0 [m/s].
     Out-of-range values raise ValueError naming the key and its allowed range."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         *,
         m: float | None = None,
         cx: float | None = None,
@@ -42,7 +55,7 @@ class Scenario:
         z0: float | None = None,
         vx0: float | None = None,
         vz0: float | None = None,
-    ) -> None: ...
+    ) -> Scenario: ...
     @staticmethod
     def table1() -> Scenario:
         """The paper's Table 1 rotor at 1200 rpm, dt = 0.1 ms, 1 s, from rest."""

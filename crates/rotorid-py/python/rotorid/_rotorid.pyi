@@ -1,10 +1,12 @@
 """The extension module (Rust). Use the package ``rotorid``; these are its building blocks."""
 
-from typing import Any
+from typing import Any, final
 
 import numpy as np
 
 from . import Scenario as Scenario
+
+__all__ = ["ESTIMATE_COLUMNS", "METHODS", "UNKNOWNS", "Scenario", "Session", "identify", "read", "simulate"]
 
 METHODS: list[str]
 UNKNOWNS: list[str]
@@ -39,15 +41,16 @@ def identify(
     rcond_min: float | None = None,
     tol: float | None = None,
     window: float | None = None,
-    time_tolerance: float = 1e-6,
+    time_tolerance: float = ...,
     input: str | None = None,
     scenario_name: str | None = None,
 ) -> tuple[str, dict[str, np.ndarray], float]:
     """(summary JSON, estimates columns, seconds spent in the library)."""
 
+@final
 class Session:
-    def __init__(
-        self,
+    def __new__(
+        cls,
         scenario: Scenario,
         method: str = "algebraic",
         dt: float | None = None,
@@ -58,8 +61,8 @@ class Session:
         rcond_min: float | None = None,
         tol: float | None = None,
         window: float | None = None,
-        time_tolerance: float = 1e-6,
-    ) -> None: ...
+        time_tolerance: float = ...,
+    ) -> Session: ...
     @property
     def samples(self) -> int: ...
     def push(
