@@ -26,7 +26,7 @@ echo "== installing the test requirements"
 "$py" -m pip install --quiet --disable-pip-version-check \
     "maturin==1.16.*" "pytest>=8,<10" "nbclient>=0.10,<0.12" "nbformat>=5.10,<6" \
     "ipykernel>=6.29,<8" "dask>=2024.1" "pandas>=2.0,<4" "numpy>=1.26,<3" \
-    "matplotlib>=3.8,<4"
+    "matplotlib>=3.8,<4" "mypy>=1.18,<3"
 
 echo "== building and installing the package (pip install crates/rotorid-py)"
 CARGO_TARGET_DIR="$target" "$py" -m pip install --quiet --disable-pip-version-check \
