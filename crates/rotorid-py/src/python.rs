@@ -445,7 +445,8 @@ impl PySession {
         })
     }
 
-    /// Push a chunk; returns the estimates it completed.
+    /// Push a chunk (phi alone: speed and acceleration from the scenario's profile);
+    /// returns the estimates it completed.
     #[pyo3(signature = (x, z, t=None, phi=None, phi_dot=None, phi_ddot=None))]
     #[allow(clippy::too_many_arguments)]
     fn push<'py>(
@@ -459,8 +460,13 @@ impl PySession {
         phi_ddot: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let held = Held::new(t, x, z, [phi, phi_dot, phi_ddot])?;
-        let columns = held.columns()?;
-        let e = py.detach(|| self.with(|s| s.push(&columns)))?;
+        let (t, x, z) = (opt(&held.t)?, slice(&held.x)?, slice(&held.z)?);
+        let speed = [
+            opt(&held.speed[0])?,
+            opt(&held.speed[1])?,
+            opt(&held.speed[2])?,
+        ];
+        let e = py.detach(|| self.with(|s| s.push_angle(t, x, z, speed)))?;
         estimates_dict(py, e)
     }
 

@@ -6,14 +6,16 @@
 //! command line.
 //!
 //! A [`Stream`] is the live form: chunks pushed as they arrive, on a given grid (`dt`) or
-//! on one fitted over the stamps.
+//! on one fitted over the stamps. A live chunk may carry the rotor angle phi alone (a
+//! keyphasor): its speed and acceleration then come from the scenario's profile
+//! ([`Stream::push_angle`]).
 
 use rotorid::pipeline::{
     Identification, Knowledge, Method, Session, TimeGrid, Timing, DEFAULT_GRID_HEAD,
 };
 use rotorid::SpeedProfile;
 
-use crate::columns::{Columns, Estimates};
+use crate::columns::{Columns, Estimates, SPEED_NAMES};
 use crate::error::Error;
 use crate::scenario::Scenario;
 
@@ -50,6 +52,8 @@ pub struct Stream {
     knowledge: Knowledge,
     profile: Option<SpeedProfile>,
     stamped: bool,
+    /// t0, dt of a given grid.
+    grid: Option<(f64, f64)>,
     origin: String,
 }
 
@@ -82,6 +86,7 @@ impl Stream {
             knowledge,
             profile,
             stamped: grid.is_none(),
+            grid,
             origin: scenario.origin().to_owned(),
         })
     }
@@ -120,6 +125,63 @@ impl Stream {
             self.session.push(&c.sample(i), &mut sink)?;
         }
         Ok(out)
+    }
+
+    /// Push a chunk whose speed is given in part: phi, phi_dot, phi_ddot as in
+    /// [`Stream::push`] when all three or none are given; phi with phi_dot or phi_ddot
+    /// missing takes the missing ones from the scenario's speed profile at each sample's
+    /// time (its stamp, else t0 + i dt), e.g. a keyphasor's angle on a rotor whose speed
+    /// the scenario states.
+    pub fn push_angle(
+        &mut self,
+        t: Option<&[f64]>,
+        x: &[f64],
+        z: &[f64],
+        speed: [Option<&[f64]>; 3],
+    ) -> Result<Estimates, Error> {
+        let [Some(phi), omega, omega_dot] = speed else {
+            return self.push(&Columns::new(t, x, z, speed)?);
+        };
+        if omega.is_some() && omega_dot.is_some() {
+            return self.push(&Columns::new(t, x, z, speed)?);
+        }
+        let Some(profile) = self.profile else {
+            let missing: Vec<&str> = SPEED_NAMES[1..]
+                .iter()
+                .zip([omega, omega_dot])
+                .filter(|(_, c)| c.is_none())
+                .map(|(n, _)| *n)
+                .collect();
+            return Err(Error::invalid(format!(
+                "phi is given without {}, and the scenario {} has no [speed] section to take                  them from: give them, or the speed profile in the scenario",
+                missing.join(" and "),
+                self.origin
+            )));
+        };
+        let first = self.samples();
+        let time = |i: usize| match (t, self.grid) {
+            (Some(t), _) => Some(t[i]),
+            (None, Some((t0, dt))) => Some(t0 + (first + i) as f64 * dt),
+            (None, None) => None,
+        };
+        let n = x.len();
+        let mut states = Vec::with_capacity(n);
+        for i in 0..n.min(phi.len()) {
+            states.push(time(i).map(|ti| profile.at(ti)));
+        }
+        let fill = |given: Option<&[f64]>, pick: fn(&rotorid::SpeedState) -> f64| -> Vec<f64> {
+            match given {
+                Some(v) => v.to_vec(),
+                None => states
+                    .iter()
+                    .map(|s| s.as_ref().map_or(f64::NAN, pick))
+                    .collect(),
+            }
+        };
+        let omega = fill(omega, |s| s.omega);
+        let omega_dot = fill(omega_dot, |s| s.omega_dot);
+        let c = Columns::new(t, x, z, [Some(phi), Some(&omega), Some(&omega_dot)])?;
+        self.push(&c)
     }
 
     /// Fit the grid over the stamps held back so far and identify them (a live

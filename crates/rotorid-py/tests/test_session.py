@@ -88,3 +88,24 @@ def test_errors_name_the_index_in_the_stream(noisy, table1):
     with pytest.raises(ValueError, match="sample 53: x = NaN"):
         s.push(b.x, b.z, **{k: b[k] for k in SPEED})
     assert s.samples == 53  # the samples before the bad one were taken
+
+
+def test_a_keyphasor_angle_alone(clean, table1):
+    """phi alone: speed and acceleration from the scenario's profile (here the same)."""
+    full = rotorid.Session(table1, method="algebraic", dt=1e-4)
+    angle = rotorid.Session(table1, method="algebraic", dt=1e-4)
+    for c in chunks(clean, 300):
+        a = full.push(c.x, c.z, **{k: c[k] for k in SPEED})
+        b = angle.push(c.x, c.z, phi=c.phi)
+        assert_frame_equal(a, b, check_exact=True)
+    assert angle.finish().to_dict() == full.finish().to_dict()
+    stamped = rotorid.Session(table1, method="refine")
+    for c in chunks(clean, 1000):
+        stamped.push(c.x, c.z, t=c.t, phi=c.phi, phi_dot=c.phi_dot)
+    assert stamped.finish().params["rel_error"].abs().max() < 1e-6
+    known = rotorid.Scenario(a=2.871, m_u=1e-4, d=0.15, alpha_deg=45.0)
+    s = rotorid.Session(known, method="algebraic", dt=1e-4)
+    with pytest.raises(ValueError, match="phi is given without phi_dot and phi_ddot"):
+        s.push(clean.x, clean.z, phi=clean.phi)
+    with pytest.raises(ValueError, match="missing phi; give all three or none"):
+        s.push(clean.x, clean.z, phi_dot=clean.phi_dot, phi_ddot=clean.phi_ddot)

@@ -209,7 +209,7 @@ class Session:
     Example::
 
         s = rotorid.Session(sc, method="algebraic", dt=1e-4)
-        est = s.push(x_chunk, z_chunk, phi=phi_chunk, phi_dot=w_chunk, phi_ddot=a_chunk)
+        est = s.push(x_chunk, z_chunk, phi=phi_chunk)   # speed from the scenario's profile
         res = s.finish()
     """
 
@@ -252,7 +252,9 @@ class Session:
     ) -> pd.DataFrame:
         """Push a chunk: x, z [m] (and t [s], phi [rad], phi_dot [rad/s], phi_ddot [rad/s^2]).
 
-        phi, phi_dot, phi_ddot: all three or none (then the scenario's speed profile).
+        phi, phi_dot, phi_ddot: all three, none (the scenario's speed profile gives them),
+        or phi alone (a keyphasor's angle: speed and acceleration from the scenario's
+        profile at each sample's time).
         An error (NaN, a stamp off the grid) names the sample's index in the stream; the
         samples before it are taken.
 
