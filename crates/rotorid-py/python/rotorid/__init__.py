@@ -1,0 +1,281 @@
+"""rotorid: identify the physical parameters of a 2-DOF Jeffcott rotor from vibration.
+
+The model (the paper's eq. (1), SI units throughout)::
+
+    m x'' + cx x' - a w z' - a w' z + kx x = m_u d (w^2 sin(phi+alpha) - w' cos(phi+alpha))
+    m z'' + cz z' + a w x'          + kz z = m_u d (w' sin(phi+alpha) + w^2 cos(phi+alpha))
+
+with x horizontal and z vertical displacement [m], phi the rotor angle [rad],
+w = phi' [rad/s], m [kg], c [N s/m], k [N/m], a [N s^2/m], m_u d [kg m], alpha [rad].
+
+Quick start::
+
+    import rotorid
+    sc = rotorid.Scenario.table1()
+    df = rotorid.simulate(sc, snr_db=40, seed=1)      # t, x, z, phi, phi_dot, phi_ddot
+    res = rotorid.identify(df, sc, method="refine")
+    res.params                                         # value, std_error, crb, unit, ...
+
+Every computation runs in the Rust library with the GIL released; a record gives the
+same result (``res.to_dict()``) as ``rotorid identify --summary`` on the same file.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from . import _rotorid
+from ._rotorid import ESTIMATE_COLUMNS, METHODS, UNKNOWNS, Scenario
+from ._result import Identification
+
+__all__ = [
+    "ESTIMATE_COLUMNS",
+    "METHODS",
+    "UNKNOWNS",
+    "Identification",
+    "Scenario",
+    "Session",
+    "identify",
+    "read",
+    "simulate",
+]
+
+__version__ = "0.1.0"
+
+_SPEED = ("phi", "phi_dot", "phi_ddot")
+
+
+def _scenario(sc: Scenario | str | os.PathLike[str]) -> Scenario:
+    if isinstance(sc, Scenario):
+        return sc
+    if isinstance(sc, (str, os.PathLike)):
+        return Scenario.load(os.fspath(sc))
+    raise TypeError(f"scenario: expected a rotorid.Scenario, 'table1' or a path, got {type(sc).__name__}")
+
+
+def _frame(columns: Mapping[str, np.ndarray]) -> pd.DataFrame:
+    # copy=False: each numpy array becomes its own column block, not copied into one.
+    return pd.DataFrame(dict(columns), copy=False)
+
+
+def simulate(
+    sc: Scenario | str,
+    method: str = "exact",
+    snr_db: float | None = None,
+    seed: int = 0,
+    *,
+    dt: float | None = None,
+    duration: float | None = None,
+    x0: float | None = None,
+    z0: float | None = None,
+    vx0: float | None = None,
+    vz0: float | None = None,
+) -> pd.DataFrame:
+    """Simulate the scenario's rotor, as ``rotorid simulate`` does.
+
+    Args:
+        sc: the scenario (rotor, speed, sampling and initial state all needed).
+        method: ``"exact"`` (exact discretisation at constant speed, DoPri8 otherwise,
+            ~1e-10 of the signal) or ``"newmark"`` (the paper's integrator).
+        snr_db: add white Gaussian noise to x and z at this signal-to-noise ratio [dB]
+            (sigma = RMS of the channel * 10^(-snr_db/20)); ``None`` for none.
+        seed: seed of the noise (the same seed gives the same noise as the CLI's ``--seed``).
+        dt, duration: override the scenario's sampling period and length [s].
+        x0, z0 [m], vx0, vz0 [m/s]: override the initial state.
+
+    Returns:
+        DataFrame with columns t [s], x, z [m], phi [rad], phi_dot [rad/s],
+        phi_ddot [rad/s^2]; row i at t = i dt exactly.
+    """
+    cols = _rotorid.simulate(
+        _scenario(sc), method, snr_db, seed,
+        dt=dt, duration=duration, x0=x0, z0=z0, vx0=vx0, vz0=vz0,
+    )
+    return _frame(cols)
+
+
+def read(path: str | os.PathLike[str]) -> pd.DataFrame:
+    """Read a response CSV as ``rotorid identify`` reads it.
+
+    The header names at least t, x, z (any order, extra columns ignored, a unit suffix
+    such as ``x [m]`` allowed); phi, phi_dot, phi_ddot all three or none. Values in SI.
+
+    Returns:
+        DataFrame with columns t [s], x, z [m] and, when the file has them, phi [rad],
+        phi_dot [rad/s], phi_ddot [rad/s^2], bit for bit the numbers the CLI reads.
+
+    Raises:
+        ValueError: naming the file, line and column of a field that is not a finite
+            number, a missing column or a short row. OSError: the file cannot be read.
+    """
+    return _frame(_rotorid.read(os.fspath(path)))
+
+
+def _columns(data: Any) -> dict[str, Any]:
+    """t, x, z [, phi, phi_dot, phi_ddot] of a DataFrame or a mapping of arrays."""
+    if isinstance(data, pd.DataFrame):
+        names = set(data.columns)
+
+        def get(k: str) -> Any:
+            return data[k].to_numpy() if k in names else None
+    elif isinstance(data, Mapping):
+        def get(k: str) -> Any:
+            return data.get(k)
+    else:
+        raise TypeError(
+            f"data: expected a pandas DataFrame or a dict of arrays, got {type(data).__name__}"
+        )
+    out = {k: get(k) for k in ("t", "x", "z", *_SPEED)}
+    missing = [k for k in ("t", "x", "z") if out[k] is None]
+    if missing:
+        raise ValueError(f"data: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)}: "
+                         "give t [s], x, z [m] (and phi, phi_dot, phi_ddot, or a scenario with a speed profile)")
+    return out
+
+
+def identify(
+    data: pd.DataFrame | Mapping[str, Any],
+    sc: Scenario | str,
+    method: str = "refine",
+    unknowns: Sequence[str] | None = None,
+    *,
+    quadrature: str | None = None,
+    rcond_min: float | None = None,
+    tol: float | None = None,
+    window: float | None = None,
+    time_tolerance: float = 1e-6,
+    input: str | None = None,
+    scenario: str | None = None,
+) -> Identification:
+    """Identify the rotor's parameters from one record.
+
+    Args:
+        data: DataFrame or dict of 1-D arrays: t [s], x, z [m] and optionally phi [rad],
+            phi_dot [rad/s], phi_ddot [rad/s^2] (all three or none; without them the
+            scenario's speed profile gives the speed). float64 contiguous arrays are read
+            in place; other dtypes and layouts are converted.
+        sc: what is known besides the record: a, m_u, d, alpha_deg (and the truth m, c, k
+            when stated, for errors and the Cramer-Rao bound); ``"table1"`` or a TOML path
+            are loaded.
+        method: ``"algebraic"`` (an estimate per sample), ``"modulating"`` (least squares
+            over windows) or ``"refine"`` (maximum likelihood with standard errors and the
+            Cramer-Rao bound).
+        unknowns: refine: what to estimate among m, cx, kx, cz, kz, a, unbalance
+            (default m, cx, kx, cz, kz); the others are known from the scenario.
+        quadrature: algebraic (and refine's start): trapezoid, am3, am4, am5 (default am5).
+        rcond_min: conditioning threshold in [0, 1] (default 1e-5 algebraic, 1e-8 modulating).
+        tol: algebraic: relative band of the identification time (default 0.01).
+        window: modulating and refine: window of the modulating identifier [s] (default 0.02).
+        time_tolerance: allowed deviation of a stamp from the uniform grid, relative to dt.
+        input, scenario: the names written into the summary (``to_dict()``), as the CLI
+            writes its input path and ``--scenario`` argument; default None.
+
+    Returns:
+        The :class:`Identification`.
+
+    Raises:
+        ValueError: a bad option (naming it and its allowed range), a column that is not
+            1-D or holds NaN or infinity (naming it and the sample index), non-uniform
+            sampling, or a scenario that lacks what the method needs.
+    """
+    cols = _columns(data)
+    summary, estimates, seconds = _rotorid.identify(
+        _scenario(sc), method, cols["t"], cols["x"], cols["z"],
+        cols["phi"], cols["phi_dot"], cols["phi_ddot"],
+        unknowns=None if unknowns is None else list(unknowns),
+        quadrature=quadrature, rcond_min=rcond_min, tol=tol, window=window,
+        time_tolerance=time_tolerance, input=input, scenario_name=scenario,
+    )
+    return Identification(summary, estimates, core_seconds=seconds)
+
+
+class Session:
+    """A live identification: push chunks of samples as they arrive.
+
+    Args:
+        sc: the scenario (its speed profile gives the speed of chunks without phi).
+        method: ``"algebraic"`` (estimates as samples arrive), ``"modulating"`` or
+            ``"refine"`` (one result at :meth:`finish`).
+        dt: the sampling period [s]; chunks then need no ``t`` (stamps, when given, are
+            checked against t0 + i dt). ``None``: the grid is fitted over the first 4096
+            stamps, held back until then (or until :meth:`start_now`), as the CLI does.
+        t0: time of the first sample [s] when ``dt`` is given.
+        Other keyword arguments: as :func:`identify`.
+
+    Example::
+
+        s = rotorid.Session(sc, method="algebraic", dt=1e-4)
+        est = s.push(x_chunk, z_chunk, phi=phi_chunk)   # speed from the scenario's profile
+        res = s.finish()
+    """
+
+    def __init__(
+        self,
+        sc: Scenario | str,
+        method: str = "algebraic",
+        dt: float | None = None,
+        t0: float = 0.0,
+        *,
+        unknowns: Sequence[str] | None = None,
+        quadrature: str | None = None,
+        rcond_min: float | None = None,
+        tol: float | None = None,
+        window: float | None = None,
+        time_tolerance: float = 1e-6,
+    ) -> None:
+        self._inner = _rotorid.Session(
+            _scenario(sc), method, dt, t0,
+            unknowns=None if unknowns is None else list(unknowns),
+            quadrature=quadrature, rcond_min=rcond_min, tol=tol, window=window,
+            time_tolerance=time_tolerance,
+        )
+        self._chunks: list[dict[str, np.ndarray]] = []
+
+    @property
+    def samples(self) -> int:
+        """Samples pushed so far."""
+        return self._inner.samples
+
+    def push(
+        self,
+        x: Any,
+        z: Any,
+        *,
+        t: Any = None,
+        phi: Any = None,
+        phi_dot: Any = None,
+        phi_ddot: Any = None,
+    ) -> pd.DataFrame:
+        """Push a chunk: x, z [m] (and t [s], phi [rad], phi_dot [rad/s], phi_ddot [rad/s^2]).
+
+        phi, phi_dot, phi_ddot: all three, none (the scenario's speed profile gives them),
+        or phi alone (a keyphasor's angle: speed and acceleration from the scenario's
+        profile at each sample's time).
+        An error (NaN, a stamp off the grid) names the sample's index in the stream; the
+        samples before it are taken.
+
+        Returns:
+            DataFrame of the new algebraic estimates (columns as ``Identification.estimates``);
+            empty for modulating and refine, and while a fitted grid's head is held back.
+        """
+        est = self._inner.push(x, z, t, phi, phi_dot, phi_ddot)
+        self._chunks.append(est)
+        return _frame(est)
+
+    def start_now(self) -> pd.DataFrame:
+        """Fit the grid over the stamps held back so far and return their estimates."""
+        est = self._inner.start_now()
+        self._chunks.append(est)
+        return _frame(est)
+
+    def finish(self, *, input: str | None = None, scenario: str | None = None) -> Identification:
+        """The identification of every sample pushed; its ``estimates`` hold every row."""
+        summary, rest = self._inner.finish(input=input, scenario_name=scenario)
+        chunks = [*self._chunks, rest]
+        estimates = {k: np.concatenate([c[k] for c in chunks]) for k in ESTIMATE_COLUMNS}
+        self._chunks = []
+        return Identification(summary, estimates)

@@ -1,0 +1,138 @@
+"""Type stubs of rotorid (SI units throughout; see the docstrings)."""
+
+import os
+from typing import Any, Mapping, Sequence, final
+
+import numpy as np
+import pandas as pd
+
+from ._result import Identification as Identification
+
+__all__ = [
+    "ESTIMATE_COLUMNS",
+    "METHODS",
+    "UNKNOWNS",
+    "Identification",
+    "Scenario",
+    "Session",
+    "identify",
+    "read",
+    "simulate",
+]
+
+__version__: str
+METHODS: list[str]
+UNKNOWNS: list[str]
+ESTIMATE_COLUMNS: list[str]
+
+@final
+class Scenario:
+    """A scenario: the built-in table1, a TOML file, or the file's keys as keyword
+    arguments: m [kg], cx, cz [N s/m], kx, kz [N/m], a [N s^2/m], m_u [kg], d [m],
+    alpha_deg [deg]; rpm [rev/min] (constant speed) or rpm0 [rev/min] and accel
+    [rad/s^2] (ramp), phi0_deg [deg]; dt, duration [s]; x0, z0 [m], vx0, vz0 [m/s].
+    Out-of-range values raise ValueError naming the key and its allowed range."""
+
+    def __new__(
+        cls,
+        *,
+        m: float | None = None,
+        cx: float | None = None,
+        kx: float | None = None,
+        cz: float | None = None,
+        kz: float | None = None,
+        a: float | None = None,
+        m_u: float | None = None,
+        d: float | None = None,
+        alpha_deg: float | None = None,
+        rpm: float | None = None,
+        rpm0: float | None = None,
+        accel: float | None = None,
+        phi0_deg: float | None = None,
+        dt: float | None = None,
+        duration: float | None = None,
+        x0: float | None = None,
+        z0: float | None = None,
+        vx0: float | None = None,
+        vz0: float | None = None,
+    ) -> Scenario: ...
+    @staticmethod
+    def table1() -> Scenario:
+        """The paper's Table 1 rotor at 1200 rpm, dt = 0.1 ms, 1 s, from rest."""
+    @staticmethod
+    def from_toml(path: str | os.PathLike[str]) -> Scenario:
+        """A TOML scenario file (errors name file, line, key and allowed range)."""
+    @staticmethod
+    def load(arg: str) -> Scenario:
+        """``"table1"`` or a TOML path, as the CLI's ``--scenario``."""
+    @property
+    def origin(self) -> str:
+        """``table1``, the file's path, or ``Scenario()``."""
+    def to_dict(self) -> dict[str, float]:
+        """The keys it states (keyword arguments of an equal scenario)."""
+
+def simulate(
+    sc: Scenario | str,
+    method: str = "exact",
+    snr_db: float | None = None,
+    seed: int = 0,
+    *,
+    dt: float | None = None,
+    duration: float | None = None,
+    x0: float | None = None,
+    z0: float | None = None,
+    vx0: float | None = None,
+    vz0: float | None = None,
+) -> pd.DataFrame:
+    """t [s], x, z [m], phi [rad], phi_dot [rad/s], phi_ddot [rad/s^2]."""
+
+def read(path: str | os.PathLike[str]) -> pd.DataFrame:
+    """A response CSV as the CLI reads it."""
+
+def identify(
+    data: pd.DataFrame | Mapping[str, Any],
+    sc: Scenario | str,
+    method: str = "refine",
+    unknowns: Sequence[str] | None = None,
+    *,
+    quadrature: str | None = None,
+    rcond_min: float | None = None,
+    tol: float | None = None,
+    window: float | None = None,
+    time_tolerance: float = 1e-6,
+    input: str | None = None,
+    scenario: str | None = None,
+) -> Identification:
+    """Identify one record (see the docstring)."""
+
+class Session:
+    """A live identification."""
+
+    def __init__(
+        self,
+        sc: Scenario | str,
+        method: str = "algebraic",
+        dt: float | None = None,
+        t0: float = 0.0,
+        *,
+        unknowns: Sequence[str] | None = None,
+        quadrature: str | None = None,
+        rcond_min: float | None = None,
+        tol: float | None = None,
+        window: float | None = None,
+        time_tolerance: float = 1e-6,
+    ) -> None: ...
+    @property
+    def samples(self) -> int: ...
+    def push(
+        self,
+        x: np.ndarray | Sequence[float],
+        z: np.ndarray | Sequence[float],
+        *,
+        t: np.ndarray | Sequence[float] | None = None,
+        phi: np.ndarray | Sequence[float] | None = None,
+        phi_dot: np.ndarray | Sequence[float] | None = None,
+        phi_ddot: np.ndarray | Sequence[float] | None = None,
+    ) -> pd.DataFrame: ...
+    def start_now(self) -> pd.DataFrame: ...
+    def finish(self, *, input: str | None = None, scenario: str | None = None) -> Identification: ...

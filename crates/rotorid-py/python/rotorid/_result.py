@@ -1,0 +1,223 @@
+"""The result of an identification: the library's summary (``to_dict()``, the CLI's
+SUMMARY.json) with tables and presentation on top. Nothing here computes an estimate."""
+
+from __future__ import annotations
+
+import copy
+import html
+import json
+import math
+from typing import Any, Mapping
+
+import numpy as np
+import pandas as pd
+
+_PARAM_COLUMNS = ["value", "std_error", "crb", "unit", "truth", "rel_error"]
+# ROSS's BearingElement coefficients: its y axis is rotorid's vertical z.
+_ROSS = {"kxx": "kx", "kyy": "kz", "cxx": "cx", "cyy": "cz"}
+
+
+def _nan(v: Any) -> float:
+    return math.nan if v is None else float(v)
+
+
+def _fmt(v: Any) -> str:
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return ""
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return html.escape(str(v))
+
+
+class Identification:
+    """One identification (``rotorid.identify`` or ``Session.finish``).
+
+    Attributes:
+        params: DataFrame indexed by parameter (m, cx, kx, cz, kz, a, mud, alpha; m_x and
+            m_z for the per-direction methods) with columns value, std_error, crb [the
+            parameter's unit], unit, truth and rel_error ((value - truth) / truth); NaN
+            where not determined or not given.
+        warnings: the diagnostics' messages, worst first (what the CLI prints as warnings).
+        estimates: DataFrame t [s], m_x, c_x, k_x, m_z, c_z, k_z [kg, N s/m, N/m],
+            rcond_x, rcond_z: algebraic: one row per sample, values NaN where a direction
+            is ill-conditioned (the CLI leaves them empty); modulating and refine: the one
+            row the CLI writes.
+        core_seconds: time spent in the library (identify only; for benchmarks).
+    """
+
+    def __init__(
+        self,
+        summary: str | Mapping[str, Any],
+        estimates: Mapping[str, np.ndarray] | None = None,
+        core_seconds: float | None = None,
+    ) -> None:
+        self._summary = json.loads(summary) if isinstance(summary, str) else dict(summary)
+        self._estimate_columns = dict(estimates) if estimates is not None else None
+        self._params: pd.DataFrame | None = None
+        self._estimates: pd.DataFrame | None = None
+        self.core_seconds = core_seconds
+
+    @property
+    def method(self) -> str:
+        """``algebraic``, ``modulating`` or ``refine``."""
+        return self._summary["method"]
+
+    @property
+    def params(self) -> pd.DataFrame:
+        if self._params is None:
+            rows = self._summary["parameters"]
+            self._params = pd.DataFrame(
+                {
+                    "value": [_nan(r["value"]) for r in rows],
+                    "std_error": [_nan(r["std_error"]) for r in rows],
+                    "crb": [_nan(r["crb"]) for r in rows],
+                    "unit": [r["unit"] for r in rows],
+                    "truth": [_nan(r["truth"]) for r in rows],
+                    "rel_error": [_nan(r["relative_error"]) for r in rows],
+                },
+                index=pd.Index([r["parameter"] for r in rows], name="parameter"),
+                columns=_PARAM_COLUMNS,
+            )
+        return self._params
+
+    @property
+    def warnings(self) -> list[str]:
+        return [d["message"] for d in self._summary["diagnostics"]]
+
+    @property
+    def estimates(self) -> pd.DataFrame:
+        if self._estimates is None:
+            cols = self._estimate_columns or {}
+            from . import ESTIMATE_COLUMNS
+
+            self._estimates = pd.DataFrame(
+                {k: cols.get(k, np.empty(0)) for k in ESTIMATE_COLUMNS}, copy=False
+            )
+        return self._estimates
+
+    @property
+    def rotor(self) -> dict[str, float] | None:
+        """Every parameter of eq. (1) (estimated, else known) when m, c, k are all
+        determined: m [kg], cx, cz [N s/m], kx, kz [N/m], a [N s^2/m], mud [kg m],
+        alpha [rad]; else None."""
+        r = self._summary.get("rotor")
+        return dict(r) if r is not None else None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The summary: equal to ``json.load`` of the CLI's SUMMARY.json for the same
+        record and options (with ``input`` and ``scenario`` as given to ``identify``)."""
+        return copy.deepcopy(self._summary)
+
+    def to_json(self, **kwargs: Any) -> str:
+        """The summary as JSON text (``json.dumps`` keyword arguments pass through)."""
+        return json.dumps(self._summary, **kwargs)
+
+    def to_ross_bearing_kwargs(self) -> dict[str, float]:
+        """Stiffness [N/m] and damping [N s/m] as ROSS's ``BearingElement`` takes them:
+        ``{"kxx": kx, "kyy": kz, "cxx": cx, "cyy": cz}`` (rotorid's vertical z is ROSS's y).
+
+        Raises:
+            ValueError: when one of them was not determined.
+        """
+        rotor = self._summary.get("rotor")
+        values = {}
+        missing = []
+        for ross, ours in _ROSS.items():
+            if rotor is not None:
+                values[ross] = float(rotor[ours])
+                continue
+            v = self.params["value"].get(ours, math.nan)
+            if math.isnan(v):
+                missing.append(ours)
+            else:
+                values[ross] = float(v)
+        if missing:
+            raise ValueError(
+                f"{', '.join(missing)} not determined by this identification: see its warnings"
+            )
+        return values
+
+    def __repr__(self) -> str:
+        p = self.params
+        lines = [f"<rotorid.Identification method={self.method} samples={self._summary['record']['samples']}>"]
+        for name, r in p.iterrows():
+            std = "" if math.isnan(r["std_error"]) else f" +- {r['std_error']:.3g}"
+            lines.append(f"  {name:6s} {r['value']:.6g}{std} {r['unit']}")
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        rec = self._summary["record"]
+        head = (
+            f"<p><b>rotorid {html.escape(self.method)}</b>: {rec['samples']} samples, "
+            f"t = {rec['t_first_s']:.6g} .. {rec['t_last_s']:.6g} s, dt = {rec['dt_s']:.6g} s</p>"
+        )
+        cols = ["parameter", *_PARAM_COLUMNS]
+        rows = "".join(
+            "<tr>" + "".join(f"<td>{_fmt(v)}</td>" for v in (name, *r.tolist())) + "</tr>"
+            for name, r in self.params.iterrows()
+        )
+        table = (
+            "<table><thead><tr>"
+            + "".join(f"<th>{c}</th>" for c in cols)
+            + f"</tr></thead><tbody>{rows}</tbody></table>"
+        )
+        warns = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
+        return head + table + (f"<p>Warnings:</p><ul>{warns}</ul>" if warns else "")
+
+    def plot(self, ax: Any = None) -> Any:
+        """Draw the estimates with matplotlib (``pip install rotorid[plot]``).
+
+        algebraic: m [kg], c [N s/m], k [N/m] of each direction against t [s], with the
+        truth dashed. modulating and refine: each parameter's value relative to the truth
+        (or to itself when no truth is given), with its standard error and, where
+        computed, the Cramer-Rao bound. Returns the Figure.
+        """
+        try:
+            import matplotlib.pyplot as plt
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError("plot() needs matplotlib: pip install 'rotorid[plot]'") from e
+        if self.method == "algebraic":
+            return self._plot_algebraic(plt)
+        return self._plot_batch(plt, ax)
+
+    def _plot_algebraic(self, plt: Any) -> Any:
+        e = self.estimates
+        truth = self.params["truth"]
+        fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 6))
+        for ax, q, unit, ref in zip(
+            axes, "mck", ("kg", "N s/m", "N/m"), (("m_x", "m_z"), ("cx", "cz"), ("kx", "kz"))
+        ):
+            for d, name in zip("xz", ref):
+                ax.plot(e["t"], e[f"{q}_{d}"], label=f"{q}_{d}", lw=1)
+                if name in truth.index and not math.isnan(truth[name]):
+                    ax.axhline(truth[name], ls="--", lw=0.8, color="k")
+            ax.set_ylabel(f"{q} [{unit}]")
+            ax.legend(loc="best")
+        axes[-1].set_xlabel("t [s]")
+        fig.tight_layout()
+        return fig
+
+    def _plot_batch(self, plt: Any, ax: Any) -> Any:
+        p = self.params
+        ref = p["truth"].where(~p["truth"].isna(), p["value"])
+        rel = p["value"] / ref - 1.0
+        err = p["std_error"] / ref.abs()
+        if ax is None:
+            fig, ax = plt.subplots(figsize=(7, 3.5))
+        else:
+            fig = ax.figure
+        x = np.arange(len(p))
+        ax.errorbar(x, rel, yerr=err, fmt="o", capsize=4, label="estimate +- std error")
+        crb = p["crb"] / ref.abs()
+        if not crb.isna().all():
+            ax.errorbar(x + 0.15, np.zeros(len(p)), yerr=crb, fmt="none", ecolor="gray",
+                        capsize=4, label="Cramer-Rao bound")
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_xticks(x, list(p.index))
+        basis = "truth" if not p["truth"].isna().all() else "value"
+        ax.set_ylabel(f"relative to {basis}")
+        ax.set_title(f"rotorid {self.method}")
+        ax.legend(loc="best")
+        fig.tight_layout()
+        return fig

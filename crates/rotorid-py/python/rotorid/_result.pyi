@@ -1,0 +1,33 @@
+from typing import Any, Mapping
+
+import numpy as np
+import pandas as pd
+
+class Identification:
+    """One identification; ``to_dict()`` equals the CLI's SUMMARY.json."""
+
+    core_seconds: float | None
+    def __init__(
+        self,
+        summary: str | Mapping[str, Any],
+        estimates: Mapping[str, np.ndarray] | None = None,
+        core_seconds: float | None = None,
+    ) -> None: ...
+    @property
+    def method(self) -> str: ...
+    @property
+    def params(self) -> pd.DataFrame:
+        """Index parameter; columns value, std_error, crb, unit, truth, rel_error."""
+    @property
+    def warnings(self) -> list[str]: ...
+    @property
+    def estimates(self) -> pd.DataFrame:
+        """t [s], m_x, c_x, k_x, m_z, c_z, k_z, rcond_x, rcond_z."""
+    @property
+    def rotor(self) -> dict[str, float] | None: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def to_json(self, **kwargs: Any) -> str: ...
+    def to_ross_bearing_kwargs(self) -> dict[str, float]:
+        """{"kxx": kx, "kyy": kz, "cxx": cx, "cyy": cz} [N/m, N s/m]."""
+    def _repr_html_(self) -> str: ...
+    def plot(self, ax: Any = None) -> Any: ...

@@ -1,0 +1,74 @@
+"""The extension module (Rust). Use the package ``rotorid``; these are its building blocks."""
+
+from typing import Any, final
+
+import numpy as np
+
+from . import Scenario as Scenario
+
+__all__ = ["ESTIMATE_COLUMNS", "METHODS", "UNKNOWNS", "Scenario", "Session", "identify", "read", "simulate"]
+
+METHODS: list[str]
+UNKNOWNS: list[str]
+ESTIMATE_COLUMNS: list[str]
+
+def simulate(
+    scenario: Scenario,
+    method: str = "exact",
+    snr_db: float | None = None,
+    seed: int = 0,
+    *,
+    dt: float | None = None,
+    duration: float | None = None,
+    x0: float | None = None,
+    z0: float | None = None,
+    vx0: float | None = None,
+    vz0: float | None = None,
+) -> dict[str, np.ndarray]: ...
+def read(path: str) -> dict[str, np.ndarray]: ...
+def identify(
+    scenario: Scenario,
+    method: str,
+    t: Any,
+    x: Any,
+    z: Any,
+    phi: Any = None,
+    phi_dot: Any = None,
+    phi_ddot: Any = None,
+    *,
+    unknowns: list[str] | None = None,
+    quadrature: str | None = None,
+    rcond_min: float | None = None,
+    tol: float | None = None,
+    window: float | None = None,
+    time_tolerance: float = ...,
+    input: str | None = None,
+    scenario_name: str | None = None,
+) -> tuple[str, dict[str, np.ndarray], float]:
+    """(summary JSON, estimates columns, seconds spent in the library)."""
+
+@final
+class Session:
+    def __new__(
+        cls,
+        scenario: Scenario,
+        method: str = "algebraic",
+        dt: float | None = None,
+        t0: float = 0.0,
+        *,
+        unknowns: list[str] | None = None,
+        quadrature: str | None = None,
+        rcond_min: float | None = None,
+        tol: float | None = None,
+        window: float | None = None,
+        time_tolerance: float = ...,
+    ) -> Session: ...
+    @property
+    def samples(self) -> int: ...
+    def push(
+        self, x: Any, z: Any, t: Any = None, phi: Any = None, phi_dot: Any = None, phi_ddot: Any = None
+    ) -> dict[str, np.ndarray]: ...
+    def start_now(self) -> dict[str, np.ndarray]: ...
+    def finish(
+        self, *, input: str | None = None, scenario_name: str | None = None
+    ) -> tuple[str, dict[str, np.ndarray]]: ...

@@ -1,0 +1,215 @@
+//! A record as the caller holds it: borrowed columns (numpy arrays are read in place), and
+//! the estimates table that comes back, one column per quantity.
+
+use rotorid::pipeline::{FinalEstimate, Sample, SampleEstimate};
+use rotorid::SpeedState;
+
+use crate::error::Error;
+
+/// Per-sample speed: phi \[rad\], phi_dot = w \[rad/s\], phi_ddot = w' \[rad/s^2\].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeedColumns<'a> {
+    /// Rotor angle phi \[rad\].
+    pub phi: &'a [f64],
+    /// Speed w \[rad/s\].
+    pub phi_dot: &'a [f64],
+    /// Acceleration w' \[rad/s^2\].
+    pub phi_ddot: &'a [f64],
+}
+
+/// The columns of a record (or of a chunk of a stream), one value per sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Columns<'a> {
+    /// Time stamps \[s\]; `None` on a given grid.
+    pub t: Option<&'a [f64]>,
+    /// Horizontal displacement \[m\].
+    pub x: &'a [f64],
+    /// Vertical displacement \[m\].
+    pub z: &'a [f64],
+    /// The speed per sample; `None`: the scenario's speed profile.
+    pub speed: Option<SpeedColumns<'a>>,
+}
+
+impl<'a> Columns<'a> {
+    /// The columns from optional phi, phi_dot, phi_ddot: all three or none.
+    pub fn new(
+        t: Option<&'a [f64]>,
+        x: &'a [f64],
+        z: &'a [f64],
+        phi: [Option<&'a [f64]>; 3],
+    ) -> Result<Self, Error> {
+        let speed = match phi {
+            [Some(phi), Some(phi_dot), Some(phi_ddot)] => Some(SpeedColumns {
+                phi,
+                phi_dot,
+                phi_ddot,
+            }),
+            [None, None, None] => None,
+            _ => {
+                let missing: Vec<&str> = SPEED_NAMES
+                    .iter()
+                    .zip(phi)
+                    .filter(|(_, c)| c.is_none())
+                    .map(|(n, _)| *n)
+                    .collect();
+                return Err(Error::invalid(format!(
+                    "some but not all of phi, phi_dot, phi_ddot are given: missing {}; give \
+                     all three or none (then the scenario's speed profile is used)",
+                    missing.join(", ")
+                )));
+            }
+        };
+        let c = Self { t, x, z, speed };
+        c.check_lengths()?;
+        Ok(c)
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t.map_or(self.x.len(), <[f64]>::len)
+    }
+
+    /// True when there is no sample.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Sample `i`.
+    pub fn sample(&self, i: usize) -> Sample {
+        Sample {
+            t: self.t.map(|t| t[i]),
+            x: self.x[i],
+            z: self.z[i],
+            speed: self.speed.map(|s| SpeedState {
+                phi: s.phi[i],
+                omega: s.phi_dot[i],
+                omega_dot: s.phi_ddot[i],
+            }),
+        }
+    }
+
+    fn check_lengths(&self) -> Result<(), Error> {
+        let (reference, n) = match self.t {
+            Some(t) => ("t", t.len()),
+            None => ("x", self.x.len()),
+        };
+        let mut columns = vec![("x", self.x), ("z", self.z)];
+        if let Some(s) = self.speed {
+            columns.extend([
+                ("phi", s.phi),
+                ("phi_dot", s.phi_dot),
+                ("phi_ddot", s.phi_ddot),
+            ]);
+        }
+        for (name, c) in columns {
+            if c.len() != n {
+                return Err(Error::invalid(format!(
+                    "{name} has {} samples but {reference} has {n}: every column needs one \
+                     value per sample",
+                    c.len()
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The speed columns' names.
+pub const SPEED_NAMES: [&str; 3] = ["phi", "phi_dot", "phi_ddot"];
+
+/// The estimates table's columns, as `rotorid identify --out` writes them.
+pub const ESTIMATE_COLUMNS: [&str; 9] = [
+    "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z",
+];
+
+/// Estimates, one row per estimate, in columns [`ESTIMATE_COLUMNS`]: t \[s\], m \[kg\],
+/// c \[N s/m\], k \[N/m\] per direction (NaN where the CLI leaves the field empty: an
+/// ill-conditioned direction, a value not determined), rcond per direction.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Estimates {
+    /// The columns, in the order of [`ESTIMATE_COLUMNS`].
+    pub columns: [Vec<f64>; 9],
+}
+
+impl Estimates {
+    /// Rows.
+    pub fn len(&self) -> usize {
+        self.columns[0].len()
+    }
+
+    /// True when there is no row.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The algebraic estimate at one sample: m, c, k where well conditioned and finite.
+    pub fn push_sample(&mut self, e: &SampleEstimate) {
+        let est = &e.estimate;
+        let [ok_x, ok_z] = e.well_conditioned;
+        let keep = |v: f64, ok: bool| if ok && v.is_finite() { v } else { f64::NAN };
+        let row = [
+            est.t,
+            keep(est.x.m, ok_x),
+            keep(est.x.c, ok_x),
+            keep(est.x.k, ok_x),
+            keep(est.z.m, ok_z),
+            keep(est.z.c, ok_z),
+            keep(est.z.k, ok_z),
+            est.x.rcond,
+            est.z.rcond,
+        ];
+        self.push(row);
+    }
+
+    /// The one row of a batch method (modulating, refine).
+    pub fn push_final(&mut self, f: &FinalEstimate) {
+        let v = f.values.map(|v| v.unwrap_or(f64::NAN));
+        self.push([
+            f.t_s, v[0], v[1], v[2], v[3], v[4], v[5], f.rcond.x, f.rcond.z,
+        ]);
+    }
+
+    /// The rows of `other` after these.
+    pub fn append(&mut self, other: Estimates) {
+        for (c, o) in self.columns.iter_mut().zip(other.columns) {
+            if c.is_empty() {
+                *c = o;
+            } else {
+                c.extend(o);
+            }
+        }
+    }
+
+    fn push(&mut self, row: [f64; 9]) {
+        for (c, v) in self.columns.iter_mut().zip(row) {
+            c.push(v);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn speed_is_all_three_or_none() {
+        let v = [0.0; 3];
+        let e = Columns::new(Some(&v), &v, &v, [Some(&v), None, Some(&v)]).unwrap_err();
+        assert!(e.to_string().contains("missing phi_dot;"), "{e}");
+        assert!(Columns::new(Some(&v), &v, &v, [None; 3]).is_ok());
+    }
+
+    #[test]
+    fn lengths_name_the_column() {
+        let (a, b) = ([0.0; 3], [0.0; 2]);
+        let e = Columns::new(Some(&a), &a, &b, [None; 3]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "z has 2 samples but t has 3: every column needs one value per sample"
+        );
+        let e = Columns::new(None, &a, &a, [Some(&a), Some(&a), Some(&b)]).unwrap_err();
+        assert!(e
+            .to_string()
+            .starts_with("phi_ddot has 2 samples but x has 3"));
+    }
+}

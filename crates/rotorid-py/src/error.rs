@@ -1,0 +1,41 @@
+//! The one error of the package's core: the library's own errors (each already names the
+//! field, the value and the allowed range, or the sample index and column), a keyword
+//! argument or column the caller got wrong, or a file that cannot be read. The extension
+//! module raises `OSError` for [`Error::Io`] and `ValueError` for every other variant.
+
+use rotorid::pipeline::PipelineError;
+use rotorid::scenario_file::ScenarioFileError;
+use rotorid::simulate::SimulateError;
+
+/// Why a call could not be done.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The pipeline refused the record or a setting.
+    #[error(transparent)]
+    Pipeline(#[from] PipelineError),
+    /// The scenario is incomplete or out of range.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioFileError),
+    /// The simulation could not be done.
+    #[error(transparent)]
+    Simulate(#[from] SimulateError),
+    /// A keyword argument, a column or a file's content that cannot be used; the message
+    /// names it and what is allowed.
+    #[error("{0}")]
+    Invalid(String),
+    /// A file that cannot be read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The path as given.
+        path: String,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+}
+
+impl Error {
+    /// An [`Error::Invalid`] with `message`.
+    pub fn invalid(message: impl Into<String>) -> Self {
+        Self::Invalid(message.into())
+    }
+}

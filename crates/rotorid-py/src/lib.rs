@@ -1,0 +1,23 @@
+//! The core of rotorid's Python package: pure functions over borrowed columns (no Python
+//! types), called by the extension module `rotorid._rotorid` (feature `python`), which
+//! only converts arrays and releases the GIL around them. Every computation is the
+//! library's pipeline (`rotorid::pipeline`), run as `rotorid identify` runs it, so a
+//! record gives the identical result from Python as from the command line.
+//!
+//! - [`scenario`]: scenarios from `table1`, a TOML file or keyword arguments; simulation.
+//! - [`response`]: the response CSV, read into columns.
+//! - [`columns`]: borrowed columns in, the estimates table out.
+//! - [`options`]: the method and its settings from keyword arguments.
+//! - [`stream`]: identification of a record, or of a live stream of chunks.
+
+pub mod columns;
+pub mod error;
+pub mod options;
+pub mod response;
+pub mod scenario;
+pub mod stream;
+
+#[cfg(feature = "python")]
+mod python;
+
+pub use error::Error;

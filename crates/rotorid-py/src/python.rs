@@ -1,0 +1,520 @@
+//! The extension module `rotorid._rotorid`: thin wrappers that convert arrays, call the
+//! pure functions of this crate with the GIL released, and hand back numpy arrays (moved,
+//! not copied) and the summary as JSON text. The Python package (`python/rotorid`) builds
+//! its DataFrames and result objects from these.
+//!
+//! Arrays: a contiguous float64 1-D array is read in place; anything else numpy can read
+//! as float64 (other dtypes, strides, lists, pandas Series) is converted once. The GIL is
+//! released while the library computes, so records identified from a thread pool run in
+//! parallel; as with any extension that does so, the caller must not write to an array
+//! while a call that reads it runs.
+
+use std::sync::Mutex;
+use std::time::Instant;
+
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rotorid::pipeline::DEFAULT_TIME_TOLERANCE;
+use rotorid::scenario_file::SimulationOverrides;
+
+use crate::columns::{Columns, Estimates, ESTIMATE_COLUMNS, SPEED_NAMES};
+use crate::error::Error;
+use crate::options::{self, Options};
+use crate::scenario::{self, Scenario, ScenarioKeys};
+use crate::stream::{self, Stream};
+
+/// `OSError` (its subclass by kind) for files, `ValueError` for everything else.
+fn py_err(e: Error) -> PyErr {
+    let text = e.to_string();
+    match e {
+        Error::Io { source, .. } => match source.kind() {
+            std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(text),
+            std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(text),
+            _ => PyOSError::new_err(text),
+        },
+        _ => PyValueError::new_err(text),
+    }
+}
+
+/// `obj` as a 1-D float64 array that can be read as a slice (module doc); `name` names it
+/// in messages.
+fn column<'py>(name: &str, obj: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray1<'py, f64>> {
+    let borrowed = |a: &Bound<'py, PyArray1<f64>>| {
+        a.try_readonly()
+            .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))
+    };
+    if let Ok(a) = obj.cast::<PyArray1<f64>>() {
+        if a.is_contiguous() {
+            return borrowed(a);
+        }
+    }
+    let np = obj.py().import("numpy")?;
+    let kwargs = PyDict::new(obj.py());
+    kwargs.set_item("dtype", "float64")?;
+    let converted = np
+        .call_method("asarray", (obj,), Some(&kwargs))
+        .map_err(|e| {
+            PyValueError::new_err(format!("{name}: cannot be read as float64 numbers: {e}"))
+        })?;
+    let untyped = converted.cast::<numpy::PyUntypedArray>()?;
+    if untyped.ndim() != 1 {
+        let dims: Vec<String> = untyped.shape().iter().map(usize::to_string).collect();
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected a 1-D array (one value per sample), got shape ({})",
+            dims.join(", ")
+        )));
+    }
+    let contiguous = np.call_method1("ascontiguousarray", (converted,))?;
+    borrowed(contiguous.cast::<PyArray1<f64>>()?)
+}
+
+/// An optional column.
+fn optional<'py>(
+    name: &str,
+    obj: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Option<PyReadonlyArray1<'py, f64>>> {
+    obj.filter(|o| !o.is_none())
+        .map(|o| column(name, o))
+        .transpose()
+}
+
+/// The slices of columns held by the caller.
+struct Held<'py> {
+    t: Option<PyReadonlyArray1<'py, f64>>,
+    x: PyReadonlyArray1<'py, f64>,
+    z: PyReadonlyArray1<'py, f64>,
+    speed: [Option<PyReadonlyArray1<'py, f64>>; 3],
+}
+
+impl<'py> Held<'py> {
+    fn new(
+        t: Option<&Bound<'py, PyAny>>,
+        x: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        speed: [Option<&Bound<'py, PyAny>>; 3],
+    ) -> PyResult<Self> {
+        Ok(Self {
+            t: optional("t", t)?,
+            x: column("x", x)?,
+            z: column("z", z)?,
+            speed: [
+                optional(SPEED_NAMES[0], speed[0])?,
+                optional(SPEED_NAMES[1], speed[1])?,
+                optional(SPEED_NAMES[2], speed[2])?,
+            ],
+        })
+    }
+
+    fn columns(&self) -> PyResult<Columns<'_>> {
+        Columns::new(
+            opt(&self.t)?,
+            slice(&self.x)?,
+            slice(&self.z)?,
+            [
+                opt(&self.speed[0])?,
+                opt(&self.speed[1])?,
+                opt(&self.speed[2])?,
+            ],
+        )
+        .map_err(py_err)
+    }
+}
+
+/// The values of an optional contiguous array.
+fn opt<'a>(a: &'a Option<PyReadonlyArray1<'_, f64>>) -> PyResult<Option<&'a [f64]>> {
+    a.as_ref().map(slice).transpose()
+}
+
+/// The values of a contiguous array.
+fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
+    a.as_slice()
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// The estimates as a dict of numpy arrays (moved into numpy, not copied).
+fn estimates_dict(py: Python<'_>, e: Estimates) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    for (name, c) in ESTIMATE_COLUMNS.iter().zip(e.columns) {
+        d.set_item(name, PyArray1::from_vec(py, c))?;
+    }
+    Ok(d)
+}
+
+/// A scenario: `table1`, a TOML file, or keyword arguments named as the file's keys.
+#[pyclass(module = "rotorid._rotorid", name = "Scenario", frozen)]
+pub struct PyScenario {
+    inner: Scenario,
+}
+
+#[pymethods]
+impl PyScenario {
+    #[new]
+    #[pyo3(signature = (*, m=None, cx=None, kx=None, cz=None, kz=None, a=None, m_u=None,
+        d=None, alpha_deg=None, rpm=None, rpm0=None, accel=None, phi0_deg=None, dt=None,
+        duration=None, x0=None, z0=None, vx0=None, vz0=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        m: Option<f64>,
+        cx: Option<f64>,
+        kx: Option<f64>,
+        cz: Option<f64>,
+        kz: Option<f64>,
+        a: Option<f64>,
+        m_u: Option<f64>,
+        d: Option<f64>,
+        alpha_deg: Option<f64>,
+        rpm: Option<f64>,
+        rpm0: Option<f64>,
+        accel: Option<f64>,
+        phi0_deg: Option<f64>,
+        dt: Option<f64>,
+        duration: Option<f64>,
+        x0: Option<f64>,
+        z0: Option<f64>,
+        vx0: Option<f64>,
+        vz0: Option<f64>,
+    ) -> PyResult<Self> {
+        let keys = ScenarioKeys {
+            m,
+            cx,
+            cz,
+            kx,
+            kz,
+            a,
+            m_u,
+            d,
+            alpha_deg,
+            rpm,
+            rpm0,
+            accel,
+            phi0_deg,
+            dt,
+            duration,
+            x0,
+            z0,
+            vx0,
+            vz0,
+        };
+        let inner = Scenario::from_keys(&keys).map_err(py_err)?;
+        Ok(Self { inner })
+    }
+
+    #[staticmethod]
+    fn table1() -> Self {
+        Self {
+            inner: Scenario::table1(),
+        }
+    }
+
+    #[staticmethod]
+    fn from_toml(path: std::path::PathBuf) -> PyResult<Self> {
+        let path = path.to_string_lossy();
+        let inner = Scenario::from_toml_file(&path).map_err(py_err)?;
+        Ok(Self { inner })
+    }
+
+    #[staticmethod]
+    fn load(arg: &str) -> PyResult<Self> {
+        let inner = Scenario::load(arg).map_err(py_err)?;
+        Ok(Self { inner })
+    }
+
+    #[getter]
+    fn origin(&self) -> &str {
+        self.inner.origin()
+    }
+
+    /// The keys it states (the keyword arguments of an equal scenario).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let k = self.inner.keys().map_err(py_err)?;
+        let d = PyDict::new(py);
+        for (name, v) in key_values(&k) {
+            if let Some(v) = v {
+                d.set_item(name, v)?;
+            }
+        }
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        let origin = self.inner.origin();
+        if origin == rotorid::scenario_file::BUILTIN_TABLE1 {
+            return "Scenario.table1()".to_owned();
+        }
+        if !self.inner.from_keywords() {
+            return format!("Scenario.from_toml({origin:?})");
+        }
+        let k = self.inner.keys().unwrap_or_default();
+        let given: Vec<String> = key_values(&k)
+            .into_iter()
+            .filter_map(|(name, v)| Some(format!("{name}={:?}", v?)))
+            .collect();
+        format!("Scenario({})", given.join(", "))
+    }
+}
+
+/// The keys by keyword name, in the order of `Scenario(...)`'s arguments.
+fn key_values(k: &ScenarioKeys) -> [(&'static str, Option<f64>); 19] {
+    [
+        ("m", k.m),
+        ("cx", k.cx),
+        ("kx", k.kx),
+        ("cz", k.cz),
+        ("kz", k.kz),
+        ("a", k.a),
+        ("m_u", k.m_u),
+        ("d", k.d),
+        ("alpha_deg", k.alpha_deg),
+        ("rpm", k.rpm),
+        ("rpm0", k.rpm0),
+        ("accel", k.accel),
+        ("phi0_deg", k.phi0_deg),
+        ("dt", k.dt),
+        ("duration", k.duration),
+        ("x0", k.x0),
+        ("z0", k.z0),
+        ("vx0", k.vx0),
+        ("vz0", k.vz0),
+    ]
+}
+
+/// Simulate `scenario`: a dict of arrays t, x, z, phi, phi_dot, phi_ddot.
+#[pyfunction]
+#[pyo3(signature = (scenario, method="exact", snr_db=None, seed=0, *, dt=None, duration=None,
+    x0=None, z0=None, vx0=None, vz0=None))]
+#[allow(clippy::too_many_arguments)]
+fn simulate<'py>(
+    py: Python<'py>,
+    scenario: &PyScenario,
+    method: &str,
+    snr_db: Option<f64>,
+    seed: u64,
+    dt: Option<f64>,
+    duration: Option<f64>,
+    x0: Option<f64>,
+    z0: Option<f64>,
+    vx0: Option<f64>,
+    vz0: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let ov = SimulationOverrides {
+        dt,
+        duration,
+        x: x0,
+        z: z0,
+        vx: vx0,
+        vz: vz0,
+    };
+    let sc = &scenario.inner;
+    let r = py
+        .detach(|| scenario::simulate(sc, method, &ov, snr_db.map(|s| (s, seed))))
+        .map_err(py_err)?;
+    let d = PyDict::new(py);
+    for (name, c) in [
+        ("t", r.t),
+        ("x", r.x),
+        ("z", r.z),
+        ("phi", r.phi),
+        ("phi_dot", r.phi_dot),
+        ("phi_ddot", r.phi_ddot),
+    ] {
+        d.set_item(name, PyArray1::from_vec(py, c))?;
+    }
+    Ok(d)
+}
+
+/// Read a response CSV: a dict of arrays t, x, z [, phi, phi_dot, phi_ddot].
+#[pyfunction]
+fn read(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyDict>> {
+    let path = path.to_string_lossy().into_owned();
+    let r = py.detach(|| crate::response::read(&path)).map_err(py_err)?;
+    let d = PyDict::new(py);
+    d.set_item("t", PyArray1::from_vec(py, r.t))?;
+    d.set_item("x", PyArray1::from_vec(py, r.x))?;
+    d.set_item("z", PyArray1::from_vec(py, r.z))?;
+    if let Some(speed) = r.speed {
+        for (name, c) in SPEED_NAMES.iter().zip(speed) {
+            d.set_item(name, PyArray1::from_vec(py, c))?;
+        }
+    }
+    Ok(d)
+}
+
+/// The options of a call.
+fn options_of(
+    unknowns: Option<Vec<String>>,
+    quadrature: Option<String>,
+    rcond_min: Option<f64>,
+    tol: Option<f64>,
+    window: Option<f64>,
+) -> Options {
+    Options {
+        unknowns,
+        quadrature,
+        rcond_min,
+        tol,
+        window,
+    }
+}
+
+/// Identify a record: (summary JSON, estimates dict, seconds spent in the library).
+#[pyfunction]
+#[pyo3(signature = (scenario, method, t, x, z, phi=None, phi_dot=None, phi_ddot=None, *,
+    unknowns=None, quadrature=None, rcond_min=None, tol=None, window=None,
+    time_tolerance=DEFAULT_TIME_TOLERANCE, input=None, scenario_name=None))]
+#[allow(clippy::too_many_arguments)]
+fn identify<'py>(
+    py: Python<'py>,
+    scenario: &PyScenario,
+    method: &str,
+    t: &Bound<'py, PyAny>,
+    x: &Bound<'py, PyAny>,
+    z: &Bound<'py, PyAny>,
+    phi: Option<&Bound<'py, PyAny>>,
+    phi_dot: Option<&Bound<'py, PyAny>>,
+    phi_ddot: Option<&Bound<'py, PyAny>>,
+    unknowns: Option<Vec<String>>,
+    quadrature: Option<String>,
+    rcond_min: Option<f64>,
+    tol: Option<f64>,
+    window: Option<f64>,
+    time_tolerance: f64,
+    input: Option<String>,
+    scenario_name: Option<String>,
+) -> PyResult<(String, Bound<'py, PyDict>, f64)> {
+    let o = options_of(unknowns, quadrature, rcond_min, tol, window);
+    let method = options::method(method, &o).map_err(py_err)?;
+    let held = Held::new(Some(t), x, z, [phi, phi_dot, phi_ddot])?;
+    let columns = held.columns()?;
+    let sc = &scenario.inner;
+    let (result, seconds) = py.detach(|| {
+        let start = Instant::now();
+        let r = stream::identify(&columns, sc, &method, time_tolerance);
+        (r, start.elapsed().as_secs_f64())
+    });
+    let done = result.map_err(py_err)?;
+    let summary = stream::summary_json(done.identification, input, scenario_name);
+    Ok((summary, estimates_dict(py, done.estimates)?, seconds))
+}
+
+/// A live identification: chunks pushed as they arrive.
+#[pyclass(module = "rotorid._rotorid", name = "Session")]
+pub struct PySession {
+    inner: Mutex<Option<Stream>>,
+}
+
+impl PySession {
+    fn with<T>(&self, f: impl FnOnce(&mut Stream) -> Result<T, Error>) -> PyResult<T> {
+        let mut guard = self
+            .inner
+            .lock()
+            .map_err(|_| PyValueError::new_err("the session failed in another thread"))?;
+        let s = guard
+            .as_mut()
+            .ok_or_else(|| PyValueError::new_err("the session is finished"))?;
+        f(s).map_err(py_err)
+    }
+}
+
+#[pymethods]
+impl PySession {
+    #[new]
+    #[pyo3(signature = (scenario, method="algebraic", dt=None, t0=0.0, *, unknowns=None,
+        quadrature=None, rcond_min=None, tol=None, window=None,
+        time_tolerance=DEFAULT_TIME_TOLERANCE))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        scenario: &PyScenario,
+        method: &str,
+        dt: Option<f64>,
+        t0: f64,
+        unknowns: Option<Vec<String>>,
+        quadrature: Option<String>,
+        rcond_min: Option<f64>,
+        tol: Option<f64>,
+        window: Option<f64>,
+        time_tolerance: f64,
+    ) -> PyResult<Self> {
+        let o = options_of(unknowns, quadrature, rcond_min, tol, window);
+        let method = options::method(method, &o).map_err(py_err)?;
+        let grid = dt.map(|dt| (t0, dt));
+        let s = Stream::new(&scenario.inner, &method, grid, time_tolerance).map_err(py_err)?;
+        Ok(Self {
+            inner: Mutex::new(Some(s)),
+        })
+    }
+
+    /// Push a chunk (phi alone: speed and acceleration from the scenario's profile);
+    /// returns the estimates it completed.
+    #[pyo3(signature = (x, z, t=None, phi=None, phi_dot=None, phi_ddot=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn push<'py>(
+        &self,
+        py: Python<'py>,
+        x: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        t: Option<&Bound<'py, PyAny>>,
+        phi: Option<&Bound<'py, PyAny>>,
+        phi_dot: Option<&Bound<'py, PyAny>>,
+        phi_ddot: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let held = Held::new(t, x, z, [phi, phi_dot, phi_ddot])?;
+        let (t, x, z) = (opt(&held.t)?, slice(&held.x)?, slice(&held.z)?);
+        let speed = [
+            opt(&held.speed[0])?,
+            opt(&held.speed[1])?,
+            opt(&held.speed[2])?,
+        ];
+        let e = py.detach(|| self.with(|s| s.push_angle(t, x, z, speed)))?;
+        estimates_dict(py, e)
+    }
+
+    /// Start on the stamps held back so far (a paused acquisition).
+    fn start_now<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let e = py.detach(|| self.with(Stream::start_now))?;
+        estimates_dict(py, e)
+    }
+
+    #[getter]
+    fn samples(&self) -> PyResult<usize> {
+        self.with(|s| Ok(s.samples()))
+    }
+
+    /// The identification of every sample pushed: (summary JSON, remaining estimates).
+    #[pyo3(signature = (*, input=None, scenario_name=None))]
+    fn finish<'py>(
+        &self,
+        py: Python<'py>,
+        input: Option<String>,
+        scenario_name: Option<String>,
+    ) -> PyResult<(String, Bound<'py, PyDict>)> {
+        let taken = {
+            let mut guard = self
+                .inner
+                .lock()
+                .map_err(|_| PyValueError::new_err("the session failed in another thread"))?;
+            guard
+                .take()
+                .ok_or_else(|| PyValueError::new_err("the session is finished"))?
+        };
+        let done = py.detach(|| taken.finish()).map_err(py_err)?;
+        let summary = stream::summary_json(done.identification, input, scenario_name);
+        Ok((summary, estimates_dict(py, done.estimates)?))
+    }
+}
+
+/// The extension module.
+#[pymodule]
+#[pyo3(name = "_rotorid")]
+fn rotorid_extension(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyScenario>()?;
+    m.add_class::<PySession>()?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(identify, m)?)?;
+    m.add("METHODS", options::METHOD_NAMES.to_vec())?;
+    m.add("UNKNOWNS", options::UNKNOWN_NAMES.to_vec())?;
+    m.add("ESTIMATE_COLUMNS", ESTIMATE_COLUMNS.to_vec())?;
+    Ok(())
+}
