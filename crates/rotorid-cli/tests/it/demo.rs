@@ -58,10 +58,10 @@ fn demo_json_is_complete_and_accurate() {
                     b["simulation"].as_str().unwrap(),
                     &p["parameter"].as_str().unwrap()[..1],
                 ) {
-                    // exact data, 5th-order quadrature: method.md's ~1e-8 (m, k), ~1e-6 (c)
+                    // exact data, 5th-order quadrature: docs/method.md section 3.8: ~1e-8 (m, k), ~1e-6 (c)
                     ("exact", "c") => 1e-5,
                     ("exact", _) => 1e-6,
-                    // Newmark data + trapezoid: biased by both (method.md section 6)
+                    // Newmark data + trapezoid: biased by both (docs/method.md section 3.8)
                     _ => 1e-2,
                 };
                 assert!(

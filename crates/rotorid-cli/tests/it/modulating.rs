@@ -60,7 +60,7 @@ fn beats_the_algebraic_final_estimate_on_noisy_data() {
         let truth = param(&sm, p)["truth"].as_f64().unwrap();
         assert!(((v - truth) / se).abs() < 4.0, "{p} = {v} +- {se}");
     }
-    // The algebraic estimate drifts under noise (method.md section 6): its final mass is
+    // The algebraic estimate drifts under noise (docs/method.md section 3.8): its final mass is
     // off by far more than the modulating one's.
     let m_x = param(&sa, "m_x")["estimate"].as_f64().unwrap();
     assert!((m_x / 14.29 - 1.0).abs() > 1e-2);

@@ -114,7 +114,7 @@ fn paper_writes_every_figure_and_report() {
                     };
                     assert_eq!(row["paper_time"].as_f64(), Some(paper_time));
                     if setting == "ours" {
-                        // exact data + 5th-order integrals: method.md, "Checked numbers"
+                        // exact data + 5th-order integrals: docs/method.md section 3.8
                         let bound = if p == "c" { 1e-5 } else { 1e-7 };
                         assert!(err.abs() < bound, "{case} ours {p}_{dir}: error {err:e}");
                         let ti = row["identification_time"].as_f64().unwrap();

@@ -108,7 +108,7 @@ fn recovers_table1_within_a_few_std_errors_at_the_cramer_rao_bound() {
         let rel = param(&s, name)["relative_std_error"].as_f64().unwrap();
         assert!((rel - se / v.abs()).abs() <= 1e-12 * rel);
     }
-    // method.md section 7 (state known, 0.3 s): m 9.9e-5, k 1.0e-4; estimating the initial
+    // docs/method.md section 5.4 (state known, 0.3 s): m 9.9e-5, k 1.0e-4; estimating the initial
     // state too costs a little more.
     let rel_m = param(&s, "m")["relative_std_error"].as_f64().unwrap();
     assert!(

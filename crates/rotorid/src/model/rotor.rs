@@ -166,7 +166,7 @@ mod tests {
         assert_eq!(r.m(), 14.29);
         assert_eq!(r.kx(), 1.195e6);
         assert!((r.unbalance().mud() - 1.5e-5).abs() < 1e-20);
-        // sqrt(k/m) = 289.2 rad/s (method.md section 1)
+        // sqrt(k/m) = 289.2 rad/s (docs/method.md section 1)
         assert!(((r.kx() / r.m()).sqrt() - 289.18).abs() < 0.01);
     }
 

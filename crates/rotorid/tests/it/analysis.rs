@@ -69,7 +69,7 @@ fn modes_at_rest_are_the_two_single_degree_of_freedom_oscillators() {
         assert!(mode.whirl_ratio.unwrap().abs() < 1e-9, "{mode:?}");
         assert_eq!(mode.whirl, None);
     }
-    // table1 (isotropic): 289.2 rad/s (method.md), zeta = 0.0012
+    // table1 (isotropic): 289.2 rad/s (docs/method.md section 1), zeta = 0.0012
     let [a, b] = modes(&Rotor::table1().params(), 0.0).unwrap();
     for m in [a, b] {
         assert!((m.natural_frequency - 289.18).abs() < 0.01);

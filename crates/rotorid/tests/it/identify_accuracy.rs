@@ -114,7 +114,7 @@ fn initial_conditions_do_not_matter() {
 #[test]
 fn higher_order_quadrature_is_more_accurate() {
     // Worst relative error of m, k at 0.1 s, 1200 rpm, exact data: each order better than
-    // the one before, and the trapezoid near the ~1e-4 of method.md.
+    // the one before, and the trapezoid near the ~1e-4 of docs/method.md section 3.8.
     let sc = &table1_cases(0.1)[0].1;
     let resp = response(sc, Method::Exact);
     let mk_error = |q: Quadrature| {

@@ -22,7 +22,7 @@ fn rms(v: &[f64]) -> f64 {
 fn assert_close(label: &str, got: [f64; 5], want: [f64; 5], tol: f64) {
     for ((name, g), w) in NAMES.iter().zip(got).zip(want) {
         println!(
-            "{label} {name}: {g:.3e} (method.md {w:.1e}, ratio {:.3})",
+            "{label} {name}: {g:.3e} (docs/method.md section 5.4: {w:.1e}, ratio {:.3})",
             g / w
         );
     }
