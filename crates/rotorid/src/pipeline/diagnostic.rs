@@ -142,6 +142,16 @@ pub enum Finding {
         /// The parameters concerned.
         parameters: Vec<crate::Parameter>,
     },
+    /// A speed column is not the derivative of the one before it (module `consistency`):
+    /// a unit slip. The values are withheld.
+    SpeedInconsistent {
+        /// `phi_dot` or `phi_ddot`.
+        column: String,
+        /// The column over its reference, least squares over the record.
+        factor: f64,
+        /// `d(phi)/dt` or `d(phi_dot)/dt`.
+        reference: String,
+    },
     /// The Cramer-Rao bound could not be computed.
     CrbUnavailable {
         /// Why.
@@ -178,6 +188,11 @@ impl Diagnostic {
             self.finding,
             Finding::NotIdentifiable { .. } | Finding::IllConditioned { .. }
         )
+    }
+
+    /// True for findings after which no value may be reported (wrong inputs).
+    pub fn withholds_all(&self) -> bool {
+        matches!(self.finding, Finding::SpeedInconsistent { .. })
     }
 }
 
@@ -290,6 +305,15 @@ fn message(f: &Finding) -> String {
                 .map(|p| p.name())
                 .collect::<Vec<_>>()
                 .join(", ")
+        ),
+        Finding::SpeedInconsistent {
+            column,
+            factor,
+            reference,
+        } => format!(
+            "{column} is {factor:.4}x {reference}{}: the speed columns must be phi [rad], \
+             phi_dot [rad/s], phi_ddot [rad/s^2]; every value is withheld",
+            super::consistency::hint(*factor)
         ),
         Finding::CrbUnavailable { reason } => {
             format!("the Cramer-Rao bound was not computed: {reason}")

@@ -21,6 +21,7 @@
 //! ```
 
 mod adequacy;
+mod consistency;
 mod diagnostic;
 mod error;
 mod grid;
@@ -35,6 +36,7 @@ mod start;
 pub use adequacy::{
     Adequacy, ChannelAdequacy, ADEQUACY_P_MIN, LJUNG_BOX_LAGS, NOISE_RATIO_MAX, RESIDUAL_FLOOR,
 };
+pub use consistency::SPEED_FACTOR_TOLERANCE;
 pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};
 pub use error::PipelineError;
 pub use grid::{RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE, SNAP_DT, SNAP_T0};
@@ -106,6 +108,29 @@ pub fn identify(
         ..ident.record
     };
     Ok(ident)
+}
+
+/// Withhold every value of `ident` (after a finding that invalidates the input).
+pub(crate) fn withhold_all(ident: &mut Identification) {
+    for p in &mut ident.parameters {
+        p.value = None;
+        p.determined = false;
+        p.relative_error = None;
+        p.identification_time_s = None;
+    }
+    ident.rotor = None;
+}
+
+/// Add the speed-consistency findings of `check` to `ident`, withholding its values when
+/// there are any.
+pub(crate) fn apply_speed_check(ident: &mut Identification, check: &consistency::SpeedConsistency) {
+    let found = check.findings();
+    if !found.is_empty() {
+        withhold_all(ident);
+        for d in found.into_iter().rev() {
+            ident.diagnostics.insert(0, d);
+        }
+    }
 }
 
 /// The record as reported.

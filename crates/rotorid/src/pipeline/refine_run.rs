@@ -126,7 +126,14 @@ pub(crate) fn run(
         .iter()
         .all(|r| r.determined)
         .then(|| RotorSummary::of(&fit.rotor));
-    Ok(Identification {
+    let mut check = super::consistency::SpeedConsistency::default();
+    if let super::record::Speed::Samples { .. } = rec.speed() {
+        for i in 0..rec.len() {
+            let v = rec.speed_at(i);
+            check.push(v.phi, v.omega, v.omega_dot, rec.grid().dt);
+        }
+    }
+    let mut ident = Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Refine,
         input: None,
@@ -169,7 +176,9 @@ pub(crate) fn run(
             crb_at: bound.map(|(_, at)| at),
         }),
         estimates: Vec::new(),
-    })
+    };
+    super::apply_speed_check(&mut ident, &check);
+    Ok(ident)
 }
 
 /// The residual tests of the fit (module `adequacy`); `None` when the model response

@@ -127,6 +127,7 @@ pub struct Session {
     t_last: f64,
     max_deviation: f64,
     keep: bool,
+    speed_check: super::consistency::SpeedConsistency,
 }
 
 impl Session {
@@ -172,6 +173,7 @@ impl Session {
             t_last: f64::NAN,
             max_deviation: 0.0,
             keep: false,
+            speed_check: Default::default(),
         })
     }
 
@@ -347,7 +349,10 @@ impl Session {
         let grid = self.grid.expect("an engine runs on a grid");
         let tg = grid.time(i);
         let speed = match (s.speed, self.profile) {
-            (Some(v), _) => v,
+            (Some(v), _) => {
+                self.speed_check.push(v.phi, v.omega, v.omega_dot, grid.dt);
+                v
+            }
             (None, Some(p)) => p.at(tg),
             (None, None) => return Err(PipelineError::NoSpeed),
         };
@@ -477,6 +482,7 @@ impl Session {
             }
         };
         ident.diagnostics.extend(drift);
+        super::apply_speed_check(&mut ident, &self.speed_check);
         Ok(ident)
     }
 

@@ -1,0 +1,102 @@
+//! Are the speed columns consistent with each other? phi \[rad\], phi_dot \[rad/s\] and
+//! phi_ddot \[rad/s^2\] given per sample must satisfy phi_dot = d(phi)/dt and phi_ddot =
+//! d(phi_dot)/dt; a column in other units (rpm for rad/s, degrees for radians, rpm/s for
+//! rad/s^2) breaks it by a constant factor, and the identifiers then produce confident
+//! nonsense (docs/method.md section 6.4). Over the record, the factor is the least-squares
+//! ratio
+//!
+//! ```text
+//! f = sum (d_i * v_i) / sum (v_i^2),   d_i = (phi_i - phi_(i-1)) / dt (wrapped to (-pi, pi]),
+//!                                      v_i = (phi_dot_i + phi_dot_(i-1)) / 2
+//! ```
+//!
+//! (the trapezoid rule is exact to O(dt^2) for the derivative at the mid-point), and
+//! likewise for phi_dot and phi_ddot where the acceleration is not negligible. A factor off
+//! 1 by more than [`SPEED_FACTOR_TOLERANCE`] is reported with the unit slip it suggests.
+
+use super::diagnostic::{Diagnostic, Finding};
+
+/// Relative mismatch of a derivative above which the speed columns are inconsistent
+/// (the trapezoid mid-point error on table1's ramps is ~1e-8).
+pub const SPEED_FACTOR_TOLERANCE: f64 = 1e-3;
+
+/// Running sums of the two ratios (module doc).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct SpeedConsistency {
+    last: Option<(f64, f64, f64)>,
+    dv: f64,
+    vv: f64,
+    aw: f64,
+    ww: f64,
+    /// sum of |phi_dot| and of |d(phi_dot)/dt| dt over the record, to judge whether the
+    /// acceleration is measurable
+    speed: f64,
+    change: f64,
+}
+
+impl SpeedConsistency {
+    /// The next sample's phi, phi_dot, phi_ddot, `dt` \[s\] after the previous.
+    pub(crate) fn push(&mut self, phi: f64, omega: f64, omega_dot: f64, dt: f64) {
+        if let Some((p, w, a)) = self.last {
+            let mut dphi = phi - p;
+            let tau = std::f64::consts::TAU;
+            dphi -= tau * (dphi / tau).round();
+            let d = dphi / dt;
+            let v = 0.5 * (omega + w);
+            self.dv += d * v;
+            self.vv += v * v;
+            let dw = (omega - w) / dt;
+            let va = 0.5 * (omega_dot + a);
+            self.aw += dw * va;
+            self.ww += va * va;
+            self.speed += v.abs();
+            self.change += (omega - w).abs();
+        }
+        self.last = Some((phi, omega, omega_dot));
+    }
+
+    /// The findings: each inconsistent column with its factor.
+    pub(crate) fn findings(&self) -> Vec<Diagnostic> {
+        let mut out = Vec::new();
+        if self.vv > 0.0 {
+            let f = self.dv / self.vv; // d(phi)/dt over phi_dot
+            if (f - 1.0).abs() > SPEED_FACTOR_TOLERANCE && f.is_finite() {
+                out.push(Diagnostic::new(Finding::SpeedInconsistent {
+                    column: "phi_dot".to_owned(),
+                    factor: 1.0 / f,
+                    reference: "d(phi)/dt".to_owned(),
+                }));
+            }
+        }
+        // the acceleration is judged only where the speed changes measurably
+        if self.ww > 0.0 && self.change > 1e-6 * self.speed {
+            let f = self.aw / self.ww; // d(phi_dot)/dt over phi_ddot
+            if (f - 1.0).abs() > SPEED_FACTOR_TOLERANCE && f.is_finite() {
+                out.push(Diagnostic::new(Finding::SpeedInconsistent {
+                    column: "phi_ddot".to_owned(),
+                    factor: 1.0 / f,
+                    reference: "d(phi_dot)/dt".to_owned(),
+                }));
+            }
+        }
+        out
+    }
+}
+
+/// The unit slip a factor suggests (`column` = factor x reference).
+pub(crate) fn hint(factor: f64) -> &'static str {
+    let near = |v: f64| (factor / v - 1.0).abs() < 0.01;
+    if near(60.0 / std::f64::consts::TAU) {
+        ": rpm given as rad/s (or rpm/s as rad/s^2)?"
+    } else if near(std::f64::consts::TAU / 60.0) {
+        ": the angle in rev or the speed in rad/s where rpm was meant?"
+    } else if near(1.0 / std::f64::consts::TAU) {
+        ": Hz given as rad/s?"
+    } else if near(180.0 / std::f64::consts::PI) {
+        ": degrees given as radians?"
+    } else if near(std::f64::consts::PI / 180.0) {
+        ": phi in degrees?"
+    } else {
+        ""
+    }
+}
