@@ -32,6 +32,9 @@ pub(crate) struct SpeedConsistency {
     /// acceleration is measurable
     speed: f64,
     change: f64,
+    /// sum of phi_dot times the profile's speed, and of the profile's speed squared
+    cp: f64,
+    pp: f64,
 }
 
 impl SpeedConsistency {
@@ -53,6 +56,20 @@ impl SpeedConsistency {
             self.change += (omega - w).abs();
         }
         self.last = Some((phi, omega, omega_dot));
+    }
+
+    /// The speed `profile_omega` \[rad/s\] a profile (the scenario's) gives at the same
+    /// sample, with the sample's `omega`, to compare the two.
+    pub(crate) fn push_profile(&mut self, omega: f64, profile_omega: f64) {
+        self.cp += omega * profile_omega;
+        self.pp += profile_omega * profile_omega;
+    }
+
+    /// A warning when the data's speed and the profile's differ by more than 1 %.
+    pub(crate) fn profile_finding(&self) -> Option<Diagnostic> {
+        let f = self.cp / self.pp;
+        (self.pp > 0.0 && f.is_finite() && (f - 1.0).abs() > 0.01)
+            .then(|| Diagnostic::new(Finding::SpeedDiffersFromProfile { factor: f }))
     }
 
     /// The findings: each inconsistent column with its factor.

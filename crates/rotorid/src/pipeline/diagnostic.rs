@@ -152,6 +152,12 @@ pub enum Finding {
         /// `d(phi)/dt` or `d(phi_dot)/dt`.
         reference: String,
     },
+    /// The data's phi_dot differs from the given speed profile (the scenario's `[speed]`)
+    /// by more than 1 %: one of them is in other units or describes another run.
+    SpeedDiffersFromProfile {
+        /// phi_dot over the profile's speed, least squares over the record.
+        factor: f64,
+    },
     /// The Cramer-Rao bound could not be computed.
     CrbUnavailable {
         /// Why.
@@ -313,6 +319,12 @@ fn message(f: &Finding) -> String {
         } => format!(
             "{column} is {factor:.4}x {reference}{}: the speed columns must be phi [rad], \
              phi_dot [rad/s], phi_ddot [rad/s^2]; every value is withheld",
+            super::consistency::hint(*factor)
+        ),
+        Finding::SpeedDiffersFromProfile { factor } => format!(
+            "the data's phi_dot is {factor:.4}x the speed of the scenario's [speed] profile{}: \
+             the identification used the data's columns; check the units of phi_dot or the \
+             scenario",
             super::consistency::hint(*factor)
         ),
         Finding::CrbUnavailable { reason } => {

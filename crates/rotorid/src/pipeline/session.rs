@@ -349,8 +349,11 @@ impl Session {
         let grid = self.grid.expect("an engine runs on a grid");
         let tg = grid.time(i);
         let speed = match (s.speed, self.profile) {
-            (Some(v), _) => {
+            (Some(v), profile) => {
                 self.speed_check.push(v.phi, v.omega, v.omega_dot, grid.dt);
+                if let Some(p) = profile {
+                    self.speed_check.push_profile(v.omega, p.at(tg).omega);
+                }
                 v
             }
             (None, Some(p)) => p.at(tg),
@@ -478,11 +481,14 @@ impl Session {
                 } else {
                     Record::uniform(grid, x, z, sp)?
                 };
-                return super::refine_run::run(&rec, &self.knowledge, s);
+                let mut ident = super::refine_run::run(&rec, &self.knowledge, s)?;
+                ident.diagnostics.extend(self.speed_check.profile_finding());
+                return Ok(ident);
             }
         };
         ident.diagnostics.extend(drift);
         super::apply_speed_check(&mut ident, &self.speed_check);
+        ident.diagnostics.extend(self.speed_check.profile_finding());
         Ok(ident)
     }
 

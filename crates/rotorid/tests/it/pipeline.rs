@@ -355,3 +355,41 @@ fn speed_columns_in_other_units_are_named_and_every_value_withheld() {
         id.warnings()
     );
 }
+
+#[test]
+fn a_scenario_speed_that_disagrees_with_the_data_is_said() {
+    // the data at 1200 rpm, the scenario's profile at 1260 rpm: warned, values kept
+    let model = table1().with_noise(40.0, 23);
+    let r = &model.response;
+    let wrong = rotorid::SpeedProfile::constant_rpm(1260.0, 0.0).unwrap();
+    for method in [Method::modulating(), Method::refine()] {
+        let mut s =
+            Session::new(&model.knowledge(), &method, Some(wrong), Timing::default()).unwrap();
+        for i in 0..r.t.len() {
+            let speed = Some(rotorid::SpeedState {
+                phi: r.phi[i],
+                omega: r.phi_dot[i],
+                omega_dot: r.phi_ddot[i],
+            });
+            s.push(
+                &Sample {
+                    t: Some(r.t[i]),
+                    x: r.x[i],
+                    z: r.z[i],
+                    speed,
+                },
+                &mut |_| {},
+            )
+            .unwrap();
+        }
+        let id = s.finish(&mut |_| {}).unwrap();
+        assert!(
+            id.warnings()
+                .iter()
+                .any(|w| w.contains("0.9524x the speed of the scenario")),
+            "{:?}",
+            id.warnings()
+        );
+        assert!(id.value(Parameter::Kx).is_some());
+    }
+}
