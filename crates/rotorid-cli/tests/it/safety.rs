@@ -666,6 +666,17 @@ fn interrupted(sig: i32, named_temporary: bool) -> (Measured, Vec<String>) {
     if named_temporary {
         cmd.env("ROTORID_NO_TMPFILE", "1");
     }
+    // The child starts with the default actions, as from a terminal: a test run started
+    // in the background by a shell inherits SIGINT ignored, and simulate rightly keeps an
+    // ignored signal ignored.
+    // SAFETY: only async-signal-safe calls between fork and exec.
+    unsafe {
+        std::os::unix::process::CommandExt::pre_exec(&mut cmd, || {
+            libc::signal(libc::SIGINT, libc::SIG_DFL);
+            libc::signal(libc::SIGTERM, libc::SIG_DFL);
+            Ok(())
+        });
+    }
     let child = cmd
         .stdout(Stdio::null())
         .stderr(Stdio::null())
