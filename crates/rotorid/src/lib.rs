@@ -17,6 +17,7 @@
 //! plotting (those live in the `rotorid` command).
 
 pub mod analysis;
+mod expm;
 pub mod identify;
 pub mod model;
 pub mod parameter;

@@ -117,7 +117,7 @@ fn frechet_rows(a_dt: &M6, e_dt: &M6) -> [[f64; 6]; 4] {
     big.fixed_view_mut::<6, 6>(0, 0).copy_from(a_dt);
     big.fixed_view_mut::<6, 6>(6, 6).copy_from(a_dt);
     big.fixed_view_mut::<6, 6>(0, 6).copy_from(&(e_dt * rho));
-    let ex = big.exp();
+    let ex = crate::expm::exp12(&big);
     for (r, row) in out.iter_mut().enumerate() {
         for (c, v) in row.iter_mut().enumerate() {
             *v = ex[(r, 6 + c)] / rho;
@@ -132,7 +132,7 @@ impl<'a> ExactStep<'a> {
     pub(crate) fn new(t: &Theta, cols: &Columns, w: f64, dt: f64, osc: &'a [[f64; 2]]) -> Self {
         let a = system_matrix(t, w);
         let a_dt = a * dt;
-        let ex = a_dt.exp();
+        let ex = crate::expm::exp6(&a_dt);
         let mut phi = [[0.0; 6]; 4];
         for (r, row) in phi.iter_mut().enumerate() {
             for (c, v) in row.iter_mut().enumerate() {

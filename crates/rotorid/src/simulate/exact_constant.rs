@@ -96,7 +96,7 @@ pub(crate) fn balanced_system(rotor: &Rotor, omega: f64) -> (Matrix6<f64>, [f64;
 /// Phi = expm(A6 dt) in SI units, computed in balanced units.
 pub(crate) fn transition_matrix(rotor: &Rotor, omega: f64, dt: f64) -> Matrix6<f64> {
     let (a_s, d) = balanced_system(rotor, omega);
-    let phi_s = (a_s * dt).exp();
+    let phi_s = crate::expm::exp6(&(a_s * dt));
     // Phi = D^-1 Phi_s D: entry (i, j) scaled by d_j / d_i
     Matrix6::from_fn(|i, j| phi_s[(i, j)] * d[j] / d[i])
 }
