@@ -11,7 +11,7 @@ use plotters::style::text_anchor::{HPos, VPos};
 use super::campbell::{with_std, CriticalMark};
 use super::canvas::{band, de, font, polyline, text, Axes, Drawing};
 use super::ticks::TickFormat;
-use super::Rgb;
+use super::{rgb, Rgb};
 
 /// Decades of amplitude shown below the largest value.
 const DECADES: i32 = 4;
@@ -79,10 +79,6 @@ fn log_label(v: f64) -> String {
         let d = (-(v.log10()).floor()).max(0.0) as usize;
         format!("{v:.d$}")
     }
-}
-
-fn rgb(c: Rgb) -> RGBColor {
-    RGBColor(c.0, c.1, c.2)
 }
 
 /// Channel `i`'s dash pattern: the first solid, the others dashed, so coinciding curves

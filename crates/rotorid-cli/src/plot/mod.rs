@@ -38,6 +38,11 @@ pub const DEFAULT_SIZE: (u32, u32) = (1400, 900);
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Rgb(pub u8, pub u8, pub u8);
 
+/// `c` as plotters' colour.
+pub fn rgb(c: Rgb) -> plotters::style::RGBColor {
+    plotters::style::RGBColor(c.0, c.1, c.2)
+}
+
 /// Colours from the Okabe-Ito colour-blind-safe palette (M. Okabe, K. Ito, "Color
 /// Universal Design", 2008), plus black and grey.
 pub mod palette {

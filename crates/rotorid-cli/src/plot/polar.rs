@@ -13,7 +13,7 @@ use super::bode::dash_of;
 use super::campbell::CriticalMark;
 use super::canvas::{de, polyline, text, Axes, Drawing};
 use super::ticks::TickFormat;
-use super::Rgb;
+use super::{rgb, Rgb};
 
 /// One probe's 1X vectors.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,10 +50,6 @@ const CLEAR: f64 = 0.06;
 fn position(a: f64, lag_deg: f64) -> (f64, f64) {
     let (s, c) = lag_deg.to_radians().sin_cos();
     (-a * s, a * c)
-}
-
-fn rgb(c: Rgb) -> RGBColor {
-    RGBColor(c.0, c.1, c.2)
 }
 
 impl Drawing for PolarPlot {

@@ -20,10 +20,11 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use super::canvas::de;
 use super::font::FAMILY;
 use super::geometry::{clip_polyline, decimate, finite_runs, split_at_sharp_turns, Rect};
 use super::ticks::TickFormat;
-use super::{Figure, ImageFormat, Layout, LineStyle, Panel, Rgb, Series};
+use super::{rgb, Figure, ImageFormat, Layout, LineStyle, Panel, Series};
 
 /// PNG supersampling factor.
 const SUPERSAMPLE: u32 = 2;
@@ -82,14 +83,6 @@ impl Px {
             split_sharp_turns: k > 1,
         }
     }
-}
-
-fn de<E: std::fmt::Display>(e: E) -> anyhow::Error {
-    anyhow::anyhow!("{e}")
-}
-
-fn rgb(c: Rgb) -> RGBColor {
-    RGBColor(c.0, c.1, c.2)
 }
 
 fn font(px: u32) -> TextStyle<'static> {
