@@ -1,0 +1,95 @@
+//! Named channels of samples, as any reader yields them.
+
+/// A uniform time axis implied by the file rather than stored as a channel: sample `i` is
+/// at `start + i * increment` (TDMS `wf_start_offset` / `wf_increment`, a UFF58 abscissa).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeAxis {
+    /// Time of the first sample \[s\].
+    pub start: f64,
+    /// Sampling interval \[s\], > 0.
+    pub increment: f64,
+}
+
+/// One channel of a file: its name, the unit the file gives, and its samples as stored
+/// (not yet converted to SI; see [`crate::units`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Channel {
+    /// The name as the file spells it: a CSV header without its unit suffix, a MAT
+    /// variable (`x`) or struct field (`rec.x`), a TDMS `group/channel`, an NPZ array name,
+    /// a Parquet column.
+    pub name: String,
+    /// The unit text the file gives (`um`, `rpm`, `V`), if any.
+    pub unit: Option<String>,
+    /// The samples, in the file's unit.
+    pub data: Vec<f64>,
+    /// The time axis the file implies for this channel, if any.
+    pub axis: Option<TimeAxis>,
+}
+
+/// The channels of one file.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Table {
+    /// The file's name as given by the user, for messages.
+    pub file: String,
+    /// The channels, in file order.
+    pub channels: Vec<Channel>,
+}
+
+impl Table {
+    /// The channel called `name`: an exact match first; else, when `name` has no
+    /// separator, the one channel whose last component (after `.` or `/`) is `name`.
+    /// `None` when there is none or the short name is ambiguous (see [`Table::candidates`]).
+    pub fn channel(&self, name: &str) -> Option<&Channel> {
+        if let Some(c) = self.channels.iter().find(|c| c.name == name) {
+            return Some(c);
+        }
+        let mut hits = self.candidates(name);
+        match (hits.next(), hits.next()) {
+            (Some(c), None) => Some(c),
+            _ => None,
+        }
+    }
+
+    /// Channels whose last component (after the last `.` or `/`) is `name`.
+    pub fn candidates<'a, 'n>(&'a self, name: &'n str) -> impl Iterator<Item = &'a Channel> + 'n
+    where
+        'a: 'n,
+    {
+        self.channels
+            .iter()
+            .filter(move |c| last_component(&c.name) == name)
+    }
+}
+
+/// The part of a channel name after its last `.` or `/`.
+pub fn last_component(name: &str) -> &str {
+    name.rsplit(['.', '/']).next().unwrap_or(name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ch(name: &str) -> Channel {
+        Channel {
+            name: name.into(),
+            unit: None,
+            data: vec![],
+            axis: None,
+        }
+    }
+
+    #[test]
+    fn short_names_resolve_only_when_unique() {
+        let t = Table {
+            file: "f".into(),
+            channels: vec![ch("rec.x"), ch("rec.z"), ch("g1/z"), ch("t")],
+        };
+        assert_eq!(t.channel("rec.x").unwrap().name, "rec.x");
+        assert_eq!(t.channel("x").unwrap().name, "rec.x");
+        assert_eq!(t.channel("t").unwrap().name, "t");
+        assert!(t.channel("z").is_none(), "z is ambiguous: rec.z and g1/z");
+        assert_eq!(t.channel("g1/z").unwrap().name, "g1/z");
+        assert!(t.channel("y").is_none());
+    }
+}
