@@ -142,6 +142,18 @@ pub enum Finding {
         /// The parameters concerned.
         parameters: Vec<crate::Parameter>,
     },
+    /// Many instants of the algebraic identifier are ill-conditioned: without restarts its
+    /// 3x3 systems degrade as the record grows.
+    AlgebraicIllConditioned {
+        /// The direction.
+        direction: Direction,
+        /// Flagged instants over all instants.
+        fraction: f64,
+        /// The threshold.
+        rcond_min: f64,
+        /// Whether the integrals were restarted (restart_s).
+        restarted: bool,
+    },
     /// A speed column is not the derivative of the one before it (module `consistency`):
     /// a unit slip. The values are withheld.
     SpeedInconsistent {
@@ -312,6 +324,28 @@ fn message(f: &Finding) -> String {
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
+        Finding::AlgebraicIllConditioned {
+            direction,
+            fraction,
+            rcond_min,
+            restarted,
+        } => {
+            format!(
+            "{:.0}% of the algebraic estimates of the {} direction are ill-conditioned (rcond < \
+             {rcond_min:e}) and withheld: the data {} do not separate m, c and k (a steady \
+             state at one speed, or far above a critical speed, cannot); {}",
+            100.0 * fraction,
+            direction.name(),
+            if *restarted { "in those windows" } else { "there" },
+            if *restarted {
+                "use --method modulating or refine, which weigh the whole record"
+            } else {
+                "a single identifier's integrals also degrade as the record grows: restart \
+                 them on a schedule (restart_s, --restart SECONDS) or use --method modulating \
+                 or refine"
+            }
+        )
+        }
         Finding::SpeedInconsistent {
             column,
             factor,

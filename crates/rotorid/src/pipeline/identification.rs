@@ -170,6 +170,13 @@ pub struct AlgebraicDetail {
     pub rcond_min: f64,
     /// Relative band of the identification times.
     pub tol: f64,
+    /// Restart period of the overlapping windows \[s\] (`None`: one identifier over the
+    /// whole record).
+    #[serde(default)]
+    pub restart_s: Option<f64>,
+    /// Windows started (1 without restarts).
+    #[serde(default)]
+    pub windows: u64,
     /// Ill-conditioned instants per direction (their estimates are withheld).
     pub flagged: Directions<u64>,
     /// The instant of each direction's final estimate \[s\].

@@ -44,6 +44,13 @@ pub struct AlgebraicSettings {
     pub rcond_min: f64,
     /// Relative band of the identification time (dimensionless, >= 0; default 0.01).
     pub tol: f64,
+    /// Restart period of the overlapping windows \[s\] (docs/method.md section 3.9):
+    /// every estimate then comes from integrals between half and one period old, so a
+    /// record of any length stays well conditioned. `None` (default): the paper's single
+    /// identifier over the whole record. Finite and at least 4 dt; rounded to an even
+    /// number of samples.
+    #[serde(default)]
+    pub restart_s: Option<f64>,
 }
 
 impl Default for AlgebraicSettings {
@@ -52,11 +59,29 @@ impl Default for AlgebraicSettings {
             quadrature: Quadrature::default(),
             rcond_min: DEFAULT_ALGEBRAIC_RCOND_MIN,
             tol: DEFAULT_TOLERANCE,
+            restart_s: None,
         }
     }
 }
 
 impl AlgebraicSettings {
+    /// The restart period in samples of `dt` \[s\]: `restart_s / dt` rounded to an even
+    /// number (module `identify::algebraic::windows`); `None` without restarts.
+    pub fn restart_samples(&self, dt: f64) -> Result<Option<u64>, PipelineError> {
+        let Some(p) = self.restart_s else {
+            return Ok(None);
+        };
+        let min = crate::identify::algebraic::MIN_RESTART_SAMPLES as f64 * dt;
+        check(
+            "restart_s",
+            p,
+            "finite and at least 4 sampling periods (s)",
+            |v| v >= min * (1.0 - 1e-9) && v / dt < 1e15,
+        )?;
+        let half = (p / dt / 2.0).round().max(2.0);
+        Ok(Some(2 * half as u64))
+    }
+
     /// The identifier's configuration (general speed model: phi, w, w' per sample).
     pub fn config(&self) -> Result<AlgebraicConfig, PipelineError> {
         check("tol", self.tol, "finite and >= 0 (relative)", |v| v >= 0.0)?;

@@ -64,6 +64,11 @@ use crate::parameter::Parameter;
 use identification::finite;
 use refine_run::relative_error;
 
+/// Above this fraction of ill-conditioned instants in a direction, the algebraic result
+/// warns (a correct record of table1 over 1 s has none after the first milliseconds; a
+/// 100 s record without restarts about half).
+pub const ILL_CONDITIONED_FRACTION_MAX: f64 = 0.1;
+
 /// MODULATING_STD_ERROR_BASIS: how the modulating identifier's standard errors are computed.
 pub const MODULATING_STD_ERROR_BASIS: &str =
     "first-order sandwich covariance of the least squares, with the correlations of \
@@ -225,6 +230,7 @@ fn algebraic_identification(
     tracker: &ConvergenceTracker,
     flagged: Directions<u64>,
     last: Option<AlgebraicEstimate>,
+    windows: u64,
 ) -> Identification {
     let results = tracker.results();
     let values = results.map(|r| r.final_value.unwrap_or(f64::NAN));
@@ -254,6 +260,20 @@ fn algebraic_identification(
             parameters: unsettled,
         }));
     }
+    // Without restarts the 3x3 systems degrade as the record grows (module
+    // identify::algebraic::windows): say so when many instants are flagged.
+    let samples = record.samples.max(1) as f64;
+    for (direction, n) in [(Direction::X, flagged.x), (Direction::Z, flagged.z)] {
+        let fraction = n as f64 / samples;
+        if fraction > ILL_CONDITIONED_FRACTION_MAX {
+            diagnostics.push(Diagnostic::new(Finding::AlgebraicIllConditioned {
+                direction,
+                fraction,
+                rcond_min: s.rcond_min,
+                restarted: s.restart_s.is_some(),
+            }));
+        }
+    }
     Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Algebraic,
@@ -270,6 +290,8 @@ fn algebraic_identification(
             quadrature: s.quadrature,
             rcond_min: s.rcond_min,
             tol: s.tol,
+            restart_s: s.restart_s,
+            windows,
             flagged,
             final_time_s: Directions {
                 x: results[0].final_t,

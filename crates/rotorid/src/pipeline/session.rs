@@ -10,7 +10,7 @@
 //! checked against the least-squares fit of all stamps so far. At the end the grid of all
 //! stamps is compared with the one used ([`Finding::TimeGridDrift`]).
 
-use crate::identify::algebraic::{AlgebraicEstimate, AlgebraicIdentifier, ConvergenceTracker};
+use crate::identify::algebraic::{AlgebraicEstimate, ConvergenceTracker, RestartingIdentifier};
 use crate::identify::modulating::ModulatingIdentifier;
 use crate::identify::Measurement;
 use crate::model::{SpeedProfile, SpeedState};
@@ -83,11 +83,14 @@ pub struct SampleEstimate {
     pub estimate: AlgebraicEstimate,
     /// Whether each direction's 3x3 system is well conditioned.
     pub well_conditioned: [bool; 2],
+    /// The restart window the estimate comes from (0 without restarts; see
+    /// [`AlgebraicSettings::restart_s`](super::AlgebraicSettings::restart_s)).
+    pub window: u64,
 }
 
 enum Engine {
     Algebraic {
-        id: Box<AlgebraicIdentifier>,
+        id: Box<RestartingIdentifier>,
         tracker: Box<ConvergenceTracker>,
         settings: AlgebraicSettings,
         flagged: Directions<u64>,
@@ -316,7 +319,12 @@ impl Session {
             Method::Algebraic(s) => {
                 let config = s.config()?;
                 Engine::Algebraic {
-                    id: Box::new(AlgebraicIdentifier::new(known, grid.dt, config)?),
+                    id: Box::new(RestartingIdentifier::new(
+                        known,
+                        grid.dt,
+                        config,
+                        s.restart_samples(grid.dt)?,
+                    )?),
                     tracker: Box::new(ConvergenceTracker::new(s.tol, s.rcond_min)?),
                     settings: *s,
                     flagged: Directions::default(),
@@ -374,7 +382,8 @@ impl Session {
                 last,
                 keep,
             } => {
-                let mut e = id.push(&m)?;
+                let w = id.push(&m)?;
+                let mut e = w.estimate;
                 e.t = s.t.unwrap_or(tg);
                 tracker.push(&e);
                 let ok = e.well_conditioned(settings.rcond_min);
@@ -387,6 +396,7 @@ impl Session {
                 on_estimate(&SampleEstimate {
                     estimate: e,
                     well_conditioned: ok,
+                    window: w.window,
                 });
             }
             Engine::Modulating { id } => id.push(&m)?,
@@ -434,12 +444,12 @@ impl Session {
         let drift = self.drift(grid);
         let mut ident = match self.engine.take().expect("started") {
             Engine::Algebraic {
+                id,
                 tracker,
                 settings,
                 flagged,
                 last,
                 keep,
-                ..
             } => {
                 if self.done < ALGEBRAIC_MIN_SAMPLES {
                     return Err(self.too_few(self.done));
@@ -451,6 +461,7 @@ impl Session {
                     &tracker,
                     flagged,
                     last,
+                    id.windows(),
                 );
                 ident.estimates = keep.unwrap_or_default();
                 ident

@@ -4,6 +4,7 @@
 mod identify_common;
 
 mod adequacy;
+mod algebraic_windows;
 mod analysis;
 mod identify_accuracy;
 mod identify_conditioning;

@@ -158,6 +158,13 @@ pub struct IdentifyArgs {
         "[default: ", tol_text!(), "]"))]
     pub tol: Option<f64>,
 
+    /// algebraic only: restart the identifier's integrals on overlapping windows of this
+    /// period [s] (two identifiers staggered by half a period; every estimate comes from one
+    /// between half and one period old), so a record or stream of any length keeps
+    /// producing local estimates. Without it one identifier integrates from the first sample
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    pub restart: Option<f64>,
+
     #[arg(long, value_name = "R", allow_hyphen_values = true, help = concat!(
         "Estimates whose reciprocal condition number is below this are flagged as ",
         "ill-conditioned (not written, never counted as converged) [default: ",
@@ -253,6 +260,7 @@ pub(super) fn method_of(args: &IdentifyArgs) -> anyhow::Result<Method> {
     use IdentifyMethod::{Algebraic, Modulating, Refine};
     only("--every", args.every.is_some(), &[Algebraic])?;
     only("--tol", args.tol.is_some(), &[Algebraic])?;
+    only("--restart", args.restart.is_some(), &[Algebraic])?;
     only(
         "--quadrature",
         args.quadrature.is_some(),
@@ -269,6 +277,15 @@ pub(super) fn method_of(args: &IdentifyArgs) -> anyhow::Result<Method> {
             anyhow::bail!("--tol = {tol} is out of range: must be finite and >= 0 (relative)");
         }
         algebraic.tol = tol;
+    }
+    if let Some(p) = args.restart {
+        if !(p.is_finite() && p > 0.0) {
+            anyhow::bail!(
+                "--restart = {p} is out of range: must be finite and > 0 (s; at least 4 \
+                 sampling periods)"
+            );
+        }
+        algebraic.restart_s = Some(p);
     }
     let window_s = args
         .window

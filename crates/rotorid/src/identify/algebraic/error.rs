@@ -17,6 +17,17 @@ pub enum AlgebraicError {
         /// The name as given.
         name: String,
     },
+    /// A restart period the overlapping windows cannot use.
+    #[error(
+        "restart period of {samples} samples: it must be even and at least {min} samples \
+         (two half-periods of two samples each)"
+    )]
+    RestartPeriod {
+        /// The period asked for \[samples\].
+        samples: u64,
+        /// The shortest allowed \[samples\].
+        min: u64,
+    },
 }
 
 impl From<OutOfRange> for AlgebraicError {

@@ -12,6 +12,7 @@
 //!   [`Measurement`](super::Measurement), general (variable speed) or constant-speed
 //!   ([`SpeedModel`]).
 //! - [`scaled_solve`]: scaling, solution and conditioning (rcond) of the 3x3 system.
+//! - [`RestartingIdentifier`]: overlapping restarts for records of any length.
 //! - [`ConvergenceTracker`]: final values and identification times in bounded memory.
 //! - [`identify_batch`], [`identify_response`]: whole records.
 //!
@@ -26,6 +27,7 @@ mod identifier;
 pub mod quadrature;
 pub mod scaled_solve;
 mod simd;
+mod windows;
 
 pub use batch::{identify_batch, identify_response, measurement};
 pub use config::{AlgebraicConfig, SpeedModel, DEFAULT_ALGEBRAIC_RCOND_MIN};
@@ -37,3 +39,4 @@ pub use estimate::{AlgebraicEstimate, DirectionEstimate};
 pub use identifier::AlgebraicIdentifier;
 pub use quadrature::{Quadrature, RunningIntegrals, LEVELS};
 pub use scaled_solve::{solve_scaled, ScaledSolution};
+pub use windows::{RestartingIdentifier, WindowedEstimate, MIN_RESTART_SAMPLES};
