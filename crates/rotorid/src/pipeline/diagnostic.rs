@@ -170,6 +170,23 @@ pub enum Finding {
         /// phi_dot over the profile's speed, least squares over the record.
         factor: f64,
     },
+    /// A displacement channel peaks outside what a proximity probe measures (module
+    /// `plausibility`): a unit slip?
+    ImplausibleDisplacement {
+        /// The channel.
+        direction: Direction,
+        /// Its largest |value| \[m\].
+        peak_m: f64,
+    },
+    /// The white-noise level of a channel is a large part of its RMS.
+    NoiseDominates {
+        /// The channel.
+        direction: Direction,
+        /// Noise level from fourth differences \[m\].
+        noise_m: f64,
+        /// The channel's RMS about its mean \[m\].
+        rms_m: f64,
+    },
     /// The Cramer-Rao bound could not be computed.
     CrbUnavailable {
         /// Why.
@@ -360,6 +377,32 @@ fn message(f: &Finding) -> String {
              the identification used the data's columns; check the units of phi_dot or the \
              scenario",
             super::consistency::hint(*factor)
+        ),
+        Finding::ImplausibleDisplacement { direction, peak_m } => {
+            let d = direction.name();
+            if *peak_m > super::plausibility::DISPLACEMENT_MAX_M {
+                format!(
+                    "{d} reaches {peak_m:.3e} m, more than a proximity probe measures (about \
+                     2 mm): values in um or mm read as metres? Give the unit in the header \
+                     ({d} [um]) or convert to metres"
+                )
+            } else {
+                format!(
+                    "{d} never exceeds {peak_m:.3e} m, below any probe's resolution (about \
+                     0.1 um): metres labelled as um, or a dead channel?"
+                )
+            }
+        }
+        Finding::NoiseDominates {
+            direction,
+            noise_m,
+            rms_m,
+        } => format!(
+            "the white-noise level of {} ({noise_m:.3e} m) is {:.0}% of its RMS ({rms_m:.3e} m): \
+             the record is mostly noise, or the channel is not the shaft's displacement; \
+             trust only values with small standard errors",
+            direction.name(),
+            100.0 * noise_m / rms_m
         ),
         Finding::CrbUnavailable { reason } => {
             format!("the Cramer-Rao bound was not computed: {reason}")

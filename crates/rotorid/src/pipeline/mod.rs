@@ -22,6 +22,7 @@
 
 mod adequacy;
 mod consistency;
+mod plausibility;
 mod diagnostic;
 mod error;
 mod grid;
@@ -37,6 +38,7 @@ pub use adequacy::{
     Adequacy, ChannelAdequacy, ADEQUACY_P_MIN, LJUNG_BOX_LAGS, NOISE_RATIO_MAX, RESIDUAL_FLOOR,
 };
 pub use consistency::SPEED_FACTOR_TOLERANCE;
+pub use plausibility::{DISPLACEMENT_MAX_M, DISPLACEMENT_MIN_M, NOISE_TO_SIGNAL_MAX};
 pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};
 pub use error::PipelineError;
 pub use grid::{RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE, SNAP_DT, SNAP_T0};

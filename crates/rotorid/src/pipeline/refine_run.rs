@@ -88,6 +88,7 @@ pub(crate) fn run(
             }
         }
     }
+    diagnostics.extend(super::plausibility::Magnitudes::of(rec.x(), rec.z()).findings());
     let inadequate = adequacy.is_some_and(|a| !a.model_adequate);
     let inseparable = diagnostics.iter().any(Diagnostic::inseparable) || inadequate;
     let t_last = *rec.t().last().unwrap_or(&f64::NAN);

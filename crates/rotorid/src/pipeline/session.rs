@@ -131,6 +131,7 @@ pub struct Session {
     max_deviation: f64,
     keep: bool,
     speed_check: super::consistency::SpeedConsistency,
+    magnitudes: super::plausibility::Magnitudes,
 }
 
 impl Session {
@@ -177,6 +178,7 @@ impl Session {
             max_deviation: 0.0,
             keep: false,
             speed_check: Default::default(),
+            magnitudes: Default::default(),
         })
     }
 
@@ -367,6 +369,7 @@ impl Session {
             (None, Some(p)) => p.at(tg),
             (None, None) => return Err(PipelineError::NoSpeed),
         };
+        self.magnitudes.push(s.x, s.z);
         let m = Measurement {
             t: tg,
             x: s.x,
@@ -498,6 +501,7 @@ impl Session {
             }
         };
         ident.diagnostics.extend(drift);
+        ident.diagnostics.extend(self.magnitudes.findings());
         super::apply_speed_check(&mut ident, &self.speed_check);
         ident.diagnostics.extend(self.speed_check.profile_finding());
         Ok(ident)

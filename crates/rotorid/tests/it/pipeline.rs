@@ -393,3 +393,45 @@ fn a_scenario_speed_that_disagrees_with_the_data_is_said() {
         assert!(id.value(Parameter::Kx).is_some());
     }
 }
+
+#[test]
+fn displacements_in_the_wrong_unit_are_warned_by_every_method() {
+    // "Micrometres given as metres": x and z a million times too large; and metres
+    // labelled as micrometres (converted once too often): a million times too small
+    let model = table1().with_noise(40.0, 31);
+    let r = &model.response;
+    let k = model.knowledge();
+    let speed = |r: &rotorid::simulate::TimeResponse| Speed::Samples {
+        phi: r.phi.clone(),
+        omega: r.phi_dot.clone(),
+        omega_dot: r.phi_ddot.clone(),
+    };
+    for (scale, says) in [(1e6, "more than a proximity probe"), (1e-6, "below any probe")] {
+        let x: Vec<f64> = r.x.iter().map(|v| v * scale).collect();
+        let z: Vec<f64> = r.z.iter().map(|v| v * scale).collect();
+        let rec = Record::new(r.t.clone(), x, z, speed(r), 1e-6).unwrap();
+        for method in [Method::algebraic(), Method::modulating(), Method::refine()] {
+            let id = identify(&rec, &k, &method).unwrap();
+            let found: Vec<_> = id
+                .diagnostics
+                .iter()
+                .filter(|d| matches!(d.finding, Finding::ImplausibleDisplacement { .. }))
+                .collect();
+            assert_eq!(found.len(), 2, "{:?} x{scale}: {:?}", method.name(), id.warnings());
+            assert!(found[0].message.contains(says), "{}", found[0].message);
+        }
+    }
+    // the record as simulated (about 20 um): nothing of the kind
+    let rec = Record::new(r.t.clone(), r.x.clone(), r.z.clone(), speed(r), 1e-6).unwrap();
+    for method in [Method::algebraic(), Method::modulating(), Method::refine()] {
+        let id = identify(&rec, &k, &method).unwrap();
+        assert!(
+            !id.diagnostics.iter().any(|d| matches!(
+                d.finding,
+                Finding::ImplausibleDisplacement { .. } | Finding::NoiseDominates { .. }
+            )),
+            "{:?}",
+            id.warnings()
+        );
+    }
+}
