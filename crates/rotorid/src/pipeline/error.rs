@@ -76,6 +76,14 @@ pub enum PipelineError {
         /// Why.
         why: &'static str,
     },
+    /// A record too long to keep for the modulating method's Cramer-Rao bound.
+    #[error("the record has {samples} samples; the bound is computed for at most {max}")]
+    CrbTooLong {
+        /// Samples in the record.
+        samples: usize,
+        /// The most kept.
+        max: usize,
+    },
     /// The speed is given neither per sample nor as a profile.
     #[error("no speed: give phi, phi_dot, phi_ddot per sample or a speed profile")]
     NoSpeed,

@@ -200,6 +200,11 @@ pub struct ModulatingDetail {
     pub rcond: Directions<f64>,
     /// The end of the last window \[s\] (grid time).
     pub t_s: f64,
+    /// Where the Cramer-Rao bound of `parameters[].crb` was evaluated (method modulating;
+    /// `None` when it was not computed): the bound of the model with one mass, a lower
+    /// bound for m_x and m_z (docs/method.md section 4.6).
+    #[serde(default)]
+    pub crb_at: Option<CrbAt>,
     /// Whether the noise bias was compensated.
     pub compensated: bool,
     /// How its standard errors are computed.

@@ -22,13 +22,13 @@
 
 mod adequacy;
 mod consistency;
-mod plausibility;
 mod diagnostic;
 mod error;
 mod grid;
 mod identification;
 mod knowledge;
 mod method;
+mod plausibility;
 mod record;
 mod refine_run;
 mod session;
@@ -38,7 +38,6 @@ pub use adequacy::{
     Adequacy, ChannelAdequacy, ADEQUACY_P_MIN, LJUNG_BOX_LAGS, NOISE_RATIO_MAX, RESIDUAL_FLOOR,
 };
 pub use consistency::SPEED_FACTOR_TOLERANCE;
-pub use plausibility::{DISPLACEMENT_MAX_M, DISPLACEMENT_MIN_M, NOISE_TO_SIGNAL_MAX};
 pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};
 pub use error::PipelineError;
 pub use grid::{RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE, SNAP_DT, SNAP_T0};
@@ -51,6 +50,7 @@ pub use knowledge::{Knowledge, RotorValues, Truth};
 pub use method::{
     AlgebraicSettings, Method, MethodName, ModulatingSettings, RefineSettings, StartPolicy,
 };
+pub use plausibility::{DISPLACEMENT_MAX_M, DISPLACEMENT_MIN_M, NOISE_TO_SIGNAL_MAX};
 pub use record::{rebased, Record, Speed, SpeedSource, CONSTANT_PHI_TOLERANCE};
 pub use refine_run::REFINE_MIN_SAMPLES;
 pub use session::{
@@ -324,6 +324,7 @@ pub(crate) fn modulating_detail(e: &ModulatingEstimate, rcond_min: f64) -> Modul
         t_s: e.t,
         compensated: e.compensated,
         std_error_basis: MODULATING_STD_ERROR_BASIS.to_owned(),
+        crb_at: None,
     }
 }
 
@@ -332,17 +333,23 @@ fn modulating_identification(
     k: &Knowledge,
     s: &ModulatingSettings,
     e: &ModulatingEstimate,
+    bound: Result<(crate::refine::Crb, identification::CrbAt), PipelineError>,
 ) -> Identification {
     let rcond_min = s.config.rcond_min;
     let ok = e.well_conditioned(rcond_min);
     let std = e.std_errors();
     let values = e.values();
+    let crb_of = |p: Parameter| -> Option<f64> {
+        let (b, _) = bound.as_ref().ok()?;
+        finite(b.get(p.physical().name())?.std_dev)
+    };
     let parameters = per_direction(k, values, ok, |i, r| {
         if ok[i / 3] {
             r.std_error = finite(std[i]);
             r.relative_std_error = finite(std[i] / values[i].abs());
             r.t_s = Some(e.t);
         }
+        r.crb = crb_of(r.parameter);
     });
     let mut diagnostics: Vec<Diagnostic> = [(Direction::X, e.x), (Direction::Z, e.z)]
         .iter()
@@ -360,6 +367,13 @@ fn modulating_identification(
         })
         .collect();
     diagnostics.extend(unphysical(&parameters));
+    if let Err(e) = &bound {
+        diagnostics.push(Diagnostic::new(Finding::CrbUnavailable {
+            reason: e.to_string(),
+        }));
+    }
+    let mut detail = modulating_detail(e, rcond_min);
+    detail.crb_at = bound.as_ref().ok().map(|(_, at)| *at);
     Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Modulating,
@@ -377,7 +391,7 @@ fn modulating_identification(
         adequacy: None,
         diagnostics,
         algebraic: None,
-        modulating: Some(modulating_detail(e, rcond_min)),
+        modulating: Some(detail),
         refine: None,
         estimates: Vec::new(),
     }

@@ -99,13 +99,38 @@ enum Engine {
     },
     Modulating {
         id: Box<ModulatingIdentifier>,
+        /// The samples, for the Cramer-Rao bound; dropped past [`MODULATING_CRB_MAX_SAMPLES`].
+        kept: Option<Kept>,
     },
     Refine {
-        t: Vec<f64>,
-        x: Vec<f64>,
-        z: Vec<f64>,
-        speed: [Vec<f64>; 3],
+        kept: Kept,
     },
+}
+
+/// Longest record whose samples a modulating session keeps for its Cramer-Rao bound
+/// (5 columns of 8 bytes: 80 MB); longer ones report the bound unavailable.
+pub const MODULATING_CRB_MAX_SAMPLES: usize = 2_000_000;
+
+/// Samples kept for a computation over the whole record.
+#[derive(Debug, Default)]
+struct Kept {
+    t: Vec<f64>,
+    x: Vec<f64>,
+    z: Vec<f64>,
+    speed: [Vec<f64>; 3],
+}
+
+impl Kept {
+    fn push(&mut self, t: f64, s: &Sample) {
+        self.t.push(t);
+        self.x.push(s.x);
+        self.z.push(s.z);
+        if let Some(sp) = s.speed {
+            self.speed[0].push(sp.phi);
+            self.speed[1].push(sp.omega);
+            self.speed[2].push(sp.omega_dot);
+        }
+    }
 }
 
 /// A streaming identification (module doc).
@@ -336,12 +361,10 @@ impl Session {
             }
             Method::Modulating(s) => Engine::Modulating {
                 id: Box::new(ModulatingIdentifier::new(known, grid.dt, s.config)?),
+                kept: Some(Kept::default()),
             },
             Method::Refine(_) => Engine::Refine {
-                t: Vec::new(),
-                x: Vec::new(),
-                z: Vec::new(),
-                speed: [Vec::new(), Vec::new(), Vec::new()],
+                kept: Kept::default(),
             },
         });
         for s in std::mem::take(&mut self.head) {
@@ -402,17 +425,19 @@ impl Session {
                     window: w.window,
                 });
             }
-            Engine::Modulating { id } => id.push(&m)?,
-            Engine::Refine { t, x, z, speed: v } => {
-                t.push(s.t.unwrap_or(tg));
-                x.push(s.x);
-                z.push(s.z);
-                if let Some(sp) = s.speed {
-                    v[0].push(sp.phi);
-                    v[1].push(sp.omega);
-                    v[2].push(sp.omega_dot);
+            Engine::Modulating { id, kept } => {
+                id.push(&m)?;
+                if kept
+                    .as_ref()
+                    .is_some_and(|k| k.t.len() >= MODULATING_CRB_MAX_SAMPLES)
+                {
+                    *kept = None;
+                }
+                if let Some(k) = kept {
+                    k.push(s.t.unwrap_or(tg), s);
                 }
             }
+            Engine::Refine { kept } => kept.push(s.t.unwrap_or(tg), s),
         }
         self.done += 1;
         Ok(())
@@ -469,32 +494,33 @@ impl Session {
                 ident.estimates = keep.unwrap_or_default();
                 ident
             }
-            Engine::Modulating { id } => {
+            Engine::Modulating { id, kept } => {
                 let est = id.finish()?;
                 let Method::Modulating(s) = &self.method else {
                     unreachable!("the engine follows the method")
                 };
-                super::modulating_identification(info, &self.knowledge, s, &est)
+                let bound = match kept {
+                    Some(kept) => self.record(kept, grid).and_then(|rec| {
+                        super::refine_run::modulating_bound(
+                            &rec,
+                            &self.knowledge,
+                            est.values(),
+                            est.sigma_x,
+                            est.sigma_z,
+                        )
+                    }),
+                    None => Err(PipelineError::CrbTooLong {
+                        samples: self.done,
+                        max: MODULATING_CRB_MAX_SAMPLES,
+                    }),
+                };
+                super::modulating_identification(info, &self.knowledge, s, &est, bound)
             }
-            Engine::Refine { t, x, z, speed } => {
+            Engine::Refine { kept } => {
                 let Method::Refine(s) = &self.method else {
                     unreachable!("the engine follows the method")
                 };
-                let sp = match (self.has_speed, self.profile) {
-                    (Some(true), _) => Speed::Samples {
-                        phi: speed[0].clone(),
-                        omega: speed[1].clone(),
-                        omega_dot: speed[2].clone(),
-                    },
-                    (_, Some(p)) => Speed::Profile(p),
-                    _ => return Err(PipelineError::NoSpeed),
-                };
-                let (Timing::Fit { tolerance, .. } | Timing::Grid { tolerance, .. }) = self.timing;
-                let rec = if self.stamped == Some(true) {
-                    Record::new(t, x, z, sp, tolerance)?
-                } else {
-                    Record::uniform(grid, x, z, sp)?
-                };
+                let rec = self.record(kept, grid)?;
                 let mut ident = super::refine_run::run(&rec, &self.knowledge, s)?;
                 ident.diagnostics.extend(self.speed_check.profile_finding());
                 return Ok(ident);
@@ -505,6 +531,29 @@ impl Session {
         super::apply_speed_check(&mut ident, &self.speed_check);
         ident.diagnostics.extend(self.speed_check.profile_finding());
         Ok(ident)
+    }
+
+    /// The record of the samples `kept` on `grid`.
+    fn record(&self, kept: Kept, grid: TimeGrid) -> Result<Record, PipelineError> {
+        let Kept { t, x, z, speed } = kept;
+        let sp = match (self.has_speed, self.profile) {
+            (Some(true), _) => {
+                let [phi, omega, omega_dot] = speed;
+                Speed::Samples {
+                    phi,
+                    omega,
+                    omega_dot,
+                }
+            }
+            (_, Some(p)) => Speed::Profile(p),
+            _ => return Err(PipelineError::NoSpeed),
+        };
+        let (Timing::Fit { tolerance, .. } | Timing::Grid { tolerance, .. }) = self.timing;
+        if self.stamped == Some(true) {
+            Record::new(t, x, z, sp, tolerance)
+        } else {
+            Record::uniform(grid, x, z, sp)
+        }
     }
 
     /// Fewest samples before the method can give anything: 4 for the algebraic

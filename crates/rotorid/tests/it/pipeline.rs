@@ -406,7 +406,10 @@ fn displacements_in_the_wrong_unit_are_warned_by_every_method() {
         omega: r.phi_dot.clone(),
         omega_dot: r.phi_ddot.clone(),
     };
-    for (scale, says) in [(1e6, "more than a proximity probe"), (1e-6, "below any probe")] {
+    for (scale, says) in [
+        (1e6, "more than a proximity probe"),
+        (1e-6, "below any probe"),
+    ] {
         let x: Vec<f64> = r.x.iter().map(|v| v * scale).collect();
         let z: Vec<f64> = r.z.iter().map(|v| v * scale).collect();
         let rec = Record::new(r.t.clone(), x, z, speed(r), 1e-6).unwrap();
@@ -417,7 +420,13 @@ fn displacements_in_the_wrong_unit_are_warned_by_every_method() {
                 .iter()
                 .filter(|d| matches!(d.finding, Finding::ImplausibleDisplacement { .. }))
                 .collect();
-            assert_eq!(found.len(), 2, "{:?} x{scale}: {:?}", method.name(), id.warnings());
+            assert_eq!(
+                found.len(),
+                2,
+                "{:?} x{scale}: {:?}",
+                method.name(),
+                id.warnings()
+            );
             assert!(found[0].message.contains(says), "{}", found[0].message);
         }
     }
@@ -433,5 +442,68 @@ fn displacements_in_the_wrong_unit_are_warned_by_every_method() {
             "{:?}",
             id.warnings()
         );
+    }
+}
+
+#[test]
+fn modulating_reports_the_cramer_rao_bound() {
+    use rotorid::pipeline::CrbAt;
+    use rotorid::refine::Unknowns;
+    for model in [
+        table1().with_noise(40.0, 41),
+        table1_ramp(600.0).with_noise(40.0, 42),
+    ] {
+        let rec = model.record();
+        // reference: the bound at the truth for the noise actually added (crb_at_snr)
+        let reference = model.crb(&Unknowns::default()).unwrap();
+        let sigma_ratio = |id: &rotorid::pipeline::Identification| {
+            let n = id.noise.unwrap();
+            (
+                n.sigma_x_m / reference.sigma_x,
+                n.sigma_z_m / reference.sigma_z,
+            )
+        };
+        let with_truth = identify(&rec, &model.knowledge(), &Method::modulating()).unwrap();
+        assert_eq!(
+            with_truth.modulating.as_ref().unwrap().crb_at,
+            Some(CrbAt::Truth)
+        );
+        let (rx, rz) = sigma_ratio(&with_truth);
+        // the bound scales with sigma; both noise levels are within a few % of the truth's
+        assert!(
+            (rx - 1.0).abs() < 0.05 && (rz - 1.0).abs() < 0.05,
+            "{rx} {rz}"
+        );
+        let mut blind = model.knowledge();
+        blind.truth = None;
+        let at_estimate = identify(&rec, &blind, &Method::modulating()).unwrap();
+        assert_eq!(
+            at_estimate.modulating.as_ref().unwrap().crb_at,
+            Some(CrbAt::Estimate)
+        );
+        for p in Parameter::PER_DIRECTION {
+            let want = reference.get(p.physical().name()).unwrap().std_dev;
+            let got = with_truth.parameter(p).unwrap().crb.unwrap();
+            assert!(
+                (got / want - 1.0).abs() < 0.1,
+                "{} {p}: {got:e} vs {want:e}",
+                model.name
+            );
+            // at the estimate, with the initial state fitted: close to the truth's bound
+            let est = at_estimate.parameter(p).unwrap().crb.unwrap();
+            assert!(
+                (est / got - 1.0).abs() < 0.1,
+                "{} {p}: {est:e} vs {got:e}",
+                model.name
+            );
+            // no unbiased estimator beats it: the modulating standard errors are above
+            let se = with_truth.parameter(p).unwrap().std_error.unwrap();
+            assert!(
+                se >= 0.9 * got,
+                "{} {p}: se {se:e} < crb {got:e}",
+                model.name
+            );
+            eprintln!("{} {p}: modulating se / crb = {:.2}", model.name, se / got);
+        }
     }
 }

@@ -120,6 +120,9 @@ fn modulating(r: &Identification) -> String {
         value_and_error(&mut out, r, i);
         if let Some(e) = r.parameters[i].std_error {
             let _ = write!(out, "  +- {e:.2e}");
+            if let Some(b) = r.parameters[i].crb {
+                let _ = write!(out, "  (CRB {b:.2e}, {:.1}x)", e / b);
+            }
         }
         out.push('\n');
     }
@@ -129,9 +132,26 @@ fn modulating(r: &Identification) -> String {
             "  rcond x {:.2e}, z {:.2e} (threshold {:e})",
             m.rcond.x, m.rcond.z, m.rcond_min
         );
+        if let Some(at) = m.crb_at {
+            let _ = writeln!(
+                out,
+                "  CRB: Cramer-Rao bound on the standard deviation at {}, with the estimated \
+                 noise; for m_x, m_z the one-mass model's (a lower bound)",
+                crb_at(at)
+            );
+        }
     }
     let _ = write!(out, "  noise (4th differences): {}", noise(r));
     out
+}
+
+/// Where a bound was evaluated, in words.
+fn crb_at(at: CrbAt) -> &'static str {
+    match at {
+        CrbAt::Truth => "the scenario's rotor and initial state (the truth)",
+        CrbAt::TruthParameters => "the scenario's rotor with the fitted initial state",
+        CrbAt::Estimate => "the estimate (the scenario states no complete truth)",
+    }
 }
 
 /// `sigma_x = ... m, sigma_z = ... m`.
@@ -214,12 +234,7 @@ fn refine(r: &Identification) -> String {
         let _ = writeln!(out, "  initial state: {}", parts.join(", "));
     }
     let _ = writeln!(out, "  noise (residuals): {}", noise(r));
-    let at = match d.crb_at {
-        Some(CrbAt::Truth) => "the scenario's rotor and initial state (the truth)",
-        Some(CrbAt::TruthParameters) => "the scenario's rotor with the fitted initial state",
-        Some(CrbAt::Estimate) => "the estimate (the scenario states no complete truth)",
-        None => "-",
-    };
+    let at = d.crb_at.map_or("-", crb_at);
     let _ = writeln!(
         out,
         "  CRB: Cramer-Rao bound on the standard deviation at {at}, with the fitted noise"
