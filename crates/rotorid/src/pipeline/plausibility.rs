@@ -61,7 +61,7 @@ impl Magnitudes {
         let n = self.n as f64;
         for (i, direction) in [Direction::X, Direction::Z].into_iter().enumerate() {
             let peak = self.peak[i];
-            if peak > DISPLACEMENT_MAX_M || peak < DISPLACEMENT_MIN_M {
+            if !(DISPLACEMENT_MIN_M..=DISPLACEMENT_MAX_M).contains(&peak) {
                 out.push(Diagnostic::new(Finding::ImplausibleDisplacement {
                     direction,
                     peak_m: peak,
