@@ -107,7 +107,7 @@ mod tests {
             };
             assert_eq!(direction, Direction::X);
             assert!((peak_m / (20e-6 * scale) - 1.0).abs() < 1e-3);
-            assert_eq!(f[0].message.contains("um"), true, "{}", f[0].message);
+            assert!(f[0].message.contains("um"), "{}", f[0].message);
             assert_eq!(peak_m > DISPLACEMENT_MAX_M, big);
         }
     }
