@@ -56,6 +56,10 @@ pub struct ParameterResult {
     pub std_error: Option<f64>,
     /// std_error / |estimate|.
     pub relative_std_error: Option<f64>,
+    /// refine: the standard error from the autocorrelation-robust sandwich covariance
+    /// \[unit\], which does not assume a correct model (docs/method.md section 5.6).
+    #[serde(default)]
+    pub robust_std_error: Option<f64>,
     /// The Cramer-Rao bound on its standard deviation \[unit\], where computed (see
     /// `refine.crb_at`).
     pub crb: Option<f64>,
@@ -83,6 +87,7 @@ impl ParameterResult {
             estimate: None,
             std_error: None,
             relative_std_error: None,
+            robust_std_error: None,
             crb: None,
             truth: None,
             relative_error: None,
@@ -288,6 +293,13 @@ pub struct RefineDetail {
     pub std_error_basis: String,
     /// Where the Cramer-Rao bound was evaluated (`None` when not computed).
     pub crb_at: Option<CrbAt>,
+    /// The sandwich covariance's Bartlett bandwidth \[samples\] (`None`: not computed).
+    #[serde(default)]
+    pub hac_bandwidth: Option<u64>,
+    /// Pooled lag-1 autocorrelation of the noise-weighted residuals (about 0 for a
+    /// correct model).
+    #[serde(default)]
+    pub residual_lag1_autocorrelation: Option<f64>,
 }
 
 /// The result of an identification (module doc).

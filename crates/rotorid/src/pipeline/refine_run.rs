@@ -111,6 +111,7 @@ pub(crate) fn run(
                 estimate: finite(e.value),
                 std_error: finite(e.std_error),
                 relative_std_error: rel.and_then(finite),
+                robust_std_error: e.robust_std_error.and_then(finite),
                 crb: bound
                     .as_ref()
                     .and_then(|(b, _)| b.get(e.name))
@@ -175,6 +176,11 @@ pub(crate) fn run(
             discretisation: fit.discretisation.clone(),
             std_error_basis: fit.std_error_basis.to_owned(),
             crb_at: bound.map(|(_, at)| at),
+            hac_bandwidth: fit.robust.as_ref().map(|r| r.bandwidth as u64),
+            residual_lag1_autocorrelation: fit
+                .robust
+                .as_ref()
+                .and_then(|r| finite(r.residual_lag1_autocorrelation)),
         }),
         estimates: Vec::new(),
     };

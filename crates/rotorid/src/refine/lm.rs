@@ -45,7 +45,8 @@ use super::error::RefineError;
 use super::fisher::Fisher;
 use super::record::Record;
 use super::result::{
-    identifiability_warnings, rows, FittedValue, Refined, Warning, STD_ERROR_BASIS,
+    identifiability_warnings, rows, FittedValue, Refined, RobustCovariance, Warning,
+    STD_ERROR_BASIS,
 };
 use super::steady::{steady_initial_state, TRANSIENT_SIGNIFICANCE};
 use super::sweep::{Normal, NormalSink};
@@ -423,6 +424,12 @@ pub fn refine(
             }
         }
     }
+    let robust = (!fi.unidentifiable.iter().any(|&u| u) && fi.cov.iter().all(|v| v.is_finite()))
+        .then(|| {
+            super::robust::robust_covariance(
+                &disc, &cur.theta, &cols, samples, record.x, record.z, vx, vz, &fi,
+            )
+        });
     let ns = cur.normal.samples as f64;
     let sigma_x = (cur.normal.sxx / ns).sqrt();
     let sigma_z = (cur.normal.szz / ns).sqrt();
@@ -432,6 +439,7 @@ pub fn refine(
         start,
         &cols,
         &fi,
+        robust,
         Summary {
             sigma_x,
             sigma_z,
@@ -494,9 +502,15 @@ fn assemble(
     start: &RotorParams,
     cols: &Columns,
     fi: &Fisher,
+    robust: Option<super::robust::Robust>,
     s: Summary,
 ) -> Refined {
     let rs = rows(t, cols, fi);
+    let robust_rows = robust.as_ref().map(|r| {
+        let mut f = fi.clone();
+        f.cov = r.cov.clone();
+        rows(t, cols, &f)
+    });
     let starts = rows(t0, cols, fi);
     let mut warnings = Vec::new();
     if let Some(significance) = s.no_transient {
@@ -526,13 +540,14 @@ fn assemble(
     }
     let mut parameters = Vec::new();
     let mut initial_state = Vec::new();
-    for (r, r0) in rs.iter().zip(&starts) {
+    for (i, (r, r0)) in rs.iter().zip(&starts).enumerate() {
         let e = FittedValue {
             name: r.name,
             unit: r.unit,
             value: r.value,
             std_error: r.std,
             relative_std_error: r.relative,
+            robust_std_error: robust_rows.as_ref().map(|rr| rr[i].std),
             start: r0.value,
             crb: None,
         };
@@ -566,5 +581,10 @@ fn assemble(
             .map(|i| fi.cov[i * n..(i + 1) * n].to_vec())
             .collect(),
         covariance_names: cols.kinds().iter().map(|k| k.name()).collect(),
+        robust: robust.map(|r| RobustCovariance {
+            bandwidth: r.bandwidth,
+            residual_lag1_autocorrelation: r.rho,
+            covariance: (0..n).map(|i| r.cov[i * n..(i + 1) * n].to_vec()).collect(),
+        }),
     }
 }

@@ -66,6 +66,7 @@ mod lm;
 mod record;
 mod result;
 mod rk4_step;
+mod robust;
 mod speed_table;
 mod steady;
 mod sweep;
@@ -77,6 +78,7 @@ pub use error::RefineError;
 pub use lm::{refine, RefineOptions};
 pub use record::{Experiment, Record, SpeedData};
 pub use result::{
-    Bound, Crb, FittedValue, Refined, Warning, ALPHA_STD_LIMIT, CONDITION_LIMIT, STD_ERROR_BASIS,
+    Bound, Crb, FittedValue, Refined, RobustCovariance, Warning, ALPHA_STD_LIMIT, CONDITION_LIMIT,
+    STD_ERROR_BASIS,
 };
 pub use unknowns::Unknowns;

@@ -43,6 +43,10 @@ pub struct FittedValue {
     pub std_error: f64,
     /// std_error / |value| (+infinity at value 0); `None` for alpha and the initial state.
     pub relative_std_error: Option<f64>,
+    /// Standard error \[unit\] from the autocorrelation-robust sandwich covariance
+    /// ([`Refined::robust`]), which does not assume a correct model; `None` when it was not
+    /// computed (unidentifiable unknowns).
+    pub robust_std_error: Option<f64>,
     /// Starting value of the fit \[unit\].
     pub start: f64,
     /// The Cramer-Rao bound at the true parameters and true noise \[unit\], when attached
@@ -184,6 +188,20 @@ pub struct Refined {
     pub covariance: Vec<Vec<f64>>,
     /// Names of the rows/columns of `covariance`.
     pub covariance_names: Vec<&'static str>,
+    /// The sandwich covariance beside the Fisher one (docs/method.md section 5.6).
+    pub robust: Option<RobustCovariance>,
+}
+
+/// The autocorrelation-robust (HAC) sandwich covariance of a fit: F^-1 B F^-1 with the
+/// Bartlett-weighted outer products of the scores (docs/method.md section 5.6).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RobustCovariance {
+    /// Bartlett bandwidth L \[samples\] (Andrews' AR(1) rule; 0 for white residuals).
+    pub bandwidth: usize,
+    /// Pooled lag-1 autocorrelation of the noise-weighted residuals.
+    pub residual_lag1_autocorrelation: f64,
+    /// The covariance, in the order of [`Refined::covariance_names`].
+    pub covariance: Vec<Vec<f64>>,
 }
 
 /// The basis of every reported standard error.

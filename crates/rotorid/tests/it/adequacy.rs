@@ -158,3 +158,63 @@ fn hundred_seed_adequacy_rates() {
     assert!(alarms.iter().all(|&a| a <= 0.05));
     assert!(detections.iter().all(|&d| d >= 0.95));
 }
+
+/// For refine on `clean` + noise: per parameter m, cx, kx, cz, kz, whether the estimate is
+/// within 1.96 standard errors of the truth by the Fisher and by the sandwich covariance,
+/// and the ratio sandwich / Fisher.
+fn interval_check(clean: &TimeResponse, snr: f64, seed: u64) -> Vec<(bool, bool, f64)> {
+    let mut r = clean.clone();
+    add_noise(&mut r, snr, seed).unwrap();
+    let rec = Record::new(
+        r.t.clone(),
+        r.x.clone(),
+        r.z.clone(),
+        Speed::Samples {
+            phi: r.phi.clone(),
+            omega: r.phi_dot.clone(),
+            omega_dot: r.phi_ddot.clone(),
+        },
+        1e-6,
+    )
+    .unwrap();
+    let k = Knowledge::from_scenario(&Scenario::table1());
+    let id = identify(&rec, &k, &Method::refine()).unwrap();
+    id.parameters
+        .iter()
+        .map(|p| {
+            let err = (p.estimate.unwrap() - p.truth.unwrap()).abs();
+            let (se, robust) = (p.std_error.unwrap(), p.robust_std_error.unwrap());
+            (err <= 1.96 * se, err <= 1.96 * robust, robust / se)
+        })
+        .collect()
+}
+
+/// Coverage of the 95 % intervals (Fisher, sandwich) and the median sandwich / Fisher
+/// ratio over `seeds`, pooled over m, cx, kx, cz, kz.
+fn coverage(clean: &TimeResponse, snr: f64, seeds: std::ops::Range<u64>) -> (f64, f64, f64) {
+    let mut all = Vec::new();
+    for s in seeds {
+        all.extend(interval_check(clean, snr, s));
+    }
+    let n = all.len() as f64;
+    let fisher = all.iter().filter(|c| c.0).count() as f64 / n;
+    let robust = all.iter().filter(|c| c.1).count() as f64 / n;
+    let mut ratios: Vec<f64> = all.iter().map(|c| c.2).collect();
+    ratios.sort_by(f64::total_cmp);
+    (fisher, robust, ratios[ratios.len() / 2])
+}
+
+#[test]
+fn the_sandwich_agrees_with_fisher_on_the_model_and_widens_on_wrong_ones() {
+    // eq. (1) itself: the residuals are white, the bandwidth ~0, the two agree
+    let (f, r, ratio) = coverage(&table1().clean, 40.0, 300..308);
+    eprintln!("model itself: coverage Fisher {f:.2}, sandwich {r:.2}, median ratio {ratio:.2}");
+    assert!((0.8..1.25).contains(&ratio), "{ratio}");
+    assert!(f >= 0.8 && r >= 0.8, "{f} {r}");
+    for d in DEFECTS {
+        let (f, r, ratio) = coverage(&simulate_defective(d), 40.0, 700..708);
+        eprintln!("{d:?}: coverage Fisher {f:.2}, sandwich {r:.2}, median ratio {ratio:.2}");
+        assert!(ratio > 1.5, "{d:?}: {ratio}");
+        assert!(r >= f, "{d:?}");
+    }
+}

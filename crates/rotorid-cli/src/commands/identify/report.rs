@@ -193,19 +193,21 @@ fn refine(r: &Identification) -> String {
     );
     let _ = writeln!(
         out,
-        "  {:<6} {:>16} {:<8} {:>12} {:>11} {:>12} {:>14} {:>10}",
-        "", "value", "", "+- std err", "rel. std", "CRB", "true", "err/std"
+        "  {:<6} {:>16} {:<8} {:>12} {:>11} {:>12} {:>12} {:>14} {:>10}",
+        "", "value", "", "+- std err", "rel. std", "robust", "CRB", "true", "err/std"
     );
     for p in &r.parameters {
         let v = p.estimate.unwrap_or(f64::NAN);
         let _ = write!(
             out,
-            "  {:<6} {:>16} {:<8} {:>12} {:>11} {:>12}",
+            "  {:<6} {:>16} {:<8} {:>12} {:>11} {:>12} {:>12}",
             p.parameter.name(),
             format_sig(v, 9),
             p.unit,
             format!("+- {}", opt_e(p.std_error)),
             p.relative_std_error
+                .map_or("-".to_owned(), |r| format!("{r:.2e}")),
+            p.robust_std_error
                 .map_or("-".to_owned(), |r| format!("{r:.2e}")),
             opt_e(p.crb),
         );
@@ -234,6 +236,13 @@ fn refine(r: &Identification) -> String {
         let _ = writeln!(out, "  initial state: {}", parts.join(", "));
     }
     let _ = writeln!(out, "  noise (residuals): {}", noise(r));
+    if let (Some(l), Some(rho)) = (d.hac_bandwidth, d.residual_lag1_autocorrelation) {
+        let _ = writeln!(
+            out,
+            "  robust: sandwich standard error, Bartlett bandwidth {l} samples (residual lag-1 \
+             autocorrelation {rho:.2}); about the Fisher one when the model fits"
+        );
+    }
     let at = d.crb_at.map_or("-", crb_at);
     let _ = writeln!(
         out,
