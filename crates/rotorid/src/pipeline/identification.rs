@@ -57,7 +57,7 @@ pub struct ParameterResult {
     /// std_error / |estimate|.
     pub relative_std_error: Option<f64>,
     /// refine: the standard error from the autocorrelation-robust sandwich covariance
-    /// \[unit\], which does not assume a correct model (docs/method.md section 5.6).
+    /// \[unit\], which does not assume a correct model (docs/method.md section 5.5).
     #[serde(default)]
     pub robust_std_error: Option<f64>,
     /// The Cramer-Rao bound on its standard deviation \[unit\], where computed (see

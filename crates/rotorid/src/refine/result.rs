@@ -188,12 +188,12 @@ pub struct Refined {
     pub covariance: Vec<Vec<f64>>,
     /// Names of the rows/columns of `covariance`.
     pub covariance_names: Vec<&'static str>,
-    /// The sandwich covariance beside the Fisher one (docs/method.md section 5.6).
+    /// The sandwich covariance beside the Fisher one (docs/method.md section 5.5).
     pub robust: Option<RobustCovariance>,
 }
 
 /// The autocorrelation-robust (HAC) sandwich covariance of a fit: F^-1 B F^-1 with the
-/// Bartlett-weighted outer products of the scores (docs/method.md section 5.6).
+/// Bartlett-weighted outer products of the scores (docs/method.md section 5.5).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RobustCovariance {
     /// Bartlett bandwidth L \[samples\] (Andrews' AR(1) rule; 0 for white residuals).

@@ -1,5 +1,5 @@
 //! Standard errors that do not assume a correct model: the heteroskedasticity- and
-//! autocorrelation-consistent (HAC) sandwich covariance (docs/method.md section 5.6).
+//! autocorrelation-consistent (HAC) sandwich covariance (docs/method.md section 5.5).
 //!
 //! The Fisher covariance F^-1 holds when the residuals r_k = y_k - y(t_k; theta) are the
 //! white noise of a correct model. A wrong model leaves correlated residuals, and then the
