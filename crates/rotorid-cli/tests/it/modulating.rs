@@ -154,7 +154,21 @@ fn a_record_without_excitation_withholds_both_directions() {
         "{}",
         r.stderr
     );
-    assert_eq!(s["diagnostics"].as_array().unwrap().len(), 2);
+    // and the record itself is said to be below any probe's resolution (peaks of 1 nm) or
+    // mostly noise
+    let kinds: Vec<&str> = s["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["kind"].as_str().unwrap())
+        .collect();
+    assert_eq!(kinds.len(), 4, "{kinds:?}");
+    assert!(
+        kinds[2..]
+            .iter()
+            .all(|k| ["implausible_displacement", "noise_dominates"].contains(k)),
+        "{kinds:?}"
+    );
     let row = r.csv.lines().nth(1).unwrap();
     assert!(row.starts_with("0.3,,,,,,,"), "{row}");
 }
