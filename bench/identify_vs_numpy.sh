@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# End to end, `rotorid identify` against the same identifier written with numpy/pandas
+# (bench/numpy_identify.py: pandas.read_csv plus the vectorised identifier), both on one
+# 1,000,001-row response CSV (table1, 100 s at 10 kHz) and on the same record as binary
+# files, timed in turn (A B A B ...) in one run; prints medians and the ratio.
+#
+#   bash bench/identify_vs_numpy.sh [RUNS]      (default 5)
+#
+# Needs the release binary (built here) and Python 3 with numpy and pandas (a venv is made
+# under target/bench-venv from PyPI). Files go to target/bench-data.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+runs="${1:-5}"
+target="${CARGO_TARGET_DIR:-$PWD/target}"
+data="$target/bench-data"
+venv="$target/bench-venv"
+mkdir -p "$data"
+
+cargo build --release -q -p rotorid-cli
+rotorid="$target/release/rotorid"
+if [ ! -x "$venv/bin/python" ]; then
+  python3 -m venv "$venv"
+  "$venv/bin/pip" install -q --disable-pip-version-check "numpy>=1.26,<3" "pandas>=2.0,<4"
+fi
+py="$venv/bin/python"
+
+csv="$data/table1_100s.csv"
+if [ ! -s "$csv" ]; then
+  "$rotorid" simulate --scenario table1 --duration 100 --out "$csv"
+fi
+
+"$py" - "$runs" "$rotorid" "$py" "$csv" "$data" <<'EOF'
+import statistics, subprocess, sys, time
+runs, rotorid, py, csv, data = int(sys.argv[1]), *sys.argv[2:]
+cases = {
+    "rotorid identify --every 1000 (CSV)": [rotorid, "identify", csv, "--scenario", "table1",
+        "--every", "1000", "--out", f"{data}/est_rs.csv"],
+    "numpy/pandas identifier --every 1000 (CSV)": [py, "bench/numpy_identify.py", csv,
+        f"{data}/est_np.csv", "--every", "1000"],
+}
+times = {k: [] for k in cases}
+for k, cmd in cases.items():  # warm-up
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+for _ in range(runs):
+    for k, cmd in cases.items():
+        t0 = time.perf_counter()
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        times[k].append(time.perf_counter() - t0)
+med = {k: statistics.median(v) for k, v in times.items()}
+for k, v in med.items():
+    print(f"{k:48s} median {v:.3f} s over {runs} runs (min {min(times[k]):.3f})")
+a, b = list(med.values())
+print(f"numpy/pandas over rotorid: {b / a:.1f}x")
+EOF
