@@ -507,3 +507,33 @@ fn modulating_reports_the_cramer_rao_bound() {
         }
     }
 }
+
+#[test]
+fn the_algebraic_identifier_under_noise_says_it_has_not_settled() {
+    // the paper's identifier at 40 dB: its late estimates are noise (docs/method.md 3.8)
+    let model = table1().with_noise(40.0, 51);
+    let id = identify(&model.record(), &model.knowledge(), &Method::algebraic()).unwrap();
+    let unsettled = id.diagnostics.iter().find_map(|d| match &d.finding {
+        Finding::AlgebraicUnsettled { parameters } => Some(parameters.clone()),
+        _ => None,
+    });
+    let unsettled = unsettled.expect("warned");
+    assert!(!unsettled.is_empty());
+    // whatever is reported is physical, and every unsettled one is named in the message
+    for p in &id.parameters {
+        if let Some(v) = p.value {
+            let c = matches!(p.parameter, Parameter::Cx | Parameter::Cz);
+            assert!(if c { v >= 0.0 } else { v > 0.0 }, "{p:?}");
+        }
+    }
+    let msg = &id
+        .diagnostics
+        .iter()
+        .find(|d| matches!(d.finding, Finding::AlgebraicUnsettled { .. }))
+        .unwrap()
+        .message;
+    assert!(msg.contains("--method modulating or refine"), "{msg}");
+    for p in unsettled {
+        assert!(msg.contains(p.name()), "{msg}");
+    }
+}
