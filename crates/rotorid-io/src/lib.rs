@@ -9,8 +9,10 @@
 //!
 //! The crate does no identification: it turns bytes into SI samples and back.
 
+pub mod select;
 pub mod table;
 pub mod units;
 
+pub use select::{select, ColumnMap, SelectError, SiColumns};
 pub use table::{Channel, Table, TimeAxis};
 pub use units::{Conversion, Quantity, UnitError};
