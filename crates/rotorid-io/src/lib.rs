@@ -7,10 +7,33 @@
 //! for the role it plays (time, displacement, angle, speed, acceleration) and refuses a unit
 //! it does not know, naming the channel.
 //!
+//! [`read_table`] picks the reader by the file's extension ([`Format::from_path`]):
+//! [`mat`] (`.mat`, level 5 and v7.3), [`tdms`], [`uff`] (`.uff`, `.unv`, `.58`), [`npy`],
+//! [`npz`], [`parquet`]. CSV is read elsewhere. Every reader takes the whole file's bytes,
+//! checks each length and dimension field against them before allocating, and fails with a
+//! [`ReadError`] that names the file, the channel and the byte offset; none panics on any
+//! input (each has a cargo-fuzz target in `fuzz/`).
+//!
+//! Samples are passed through as stored: NaN and infinities are data here, and the
+//! identification pipeline checks finiteness. Integers convert to `f64` exactly or not at
+//! all ([`ReadError::InexactInteger`]).
+//!
 //! The crate does no identification: it turns bytes into SI samples and back.
 
+mod cursor;
+pub mod error;
+pub mod format;
+pub mod mat;
+pub mod npy;
+pub mod npz;
+pub mod num;
+pub mod parquet;
 pub mod table;
+pub mod tdms;
+pub mod uff;
 pub mod units;
 
+pub use error::ReadError;
+pub use format::{read_bytes, read_table, Format};
 pub use table::{Channel, Table, TimeAxis};
 pub use units::{Conversion, Quantity, UnitError};
