@@ -114,22 +114,6 @@ impl<'a> Cursor<'a> {
         self.take(n, what).map(|_| ())
     }
 
-    /// Moves to absolute buffer position `pos` (checked).
-    pub fn seek(&mut self, pos: u64, what: &str) -> Result<(), ReadError> {
-        if pos > self.data.len() as u64 {
-            return Err(ReadError::Truncated {
-                file: self.file.to_string(),
-                channel: self.channel.clone(),
-                offset: self.offset_of(self.data.len()),
-                what: self.describe(what, self.pos),
-                need: pos - self.data.len() as u64,
-                available: 0,
-            });
-        }
-        self.pos = pos as usize;
-        Ok(())
-    }
-
     pub fn array<const N: usize>(&mut self, what: &str) -> Result<[u8; N], ReadError> {
         let s = self.take(N as u64, what)?;
         let mut a = [0u8; N];
@@ -167,10 +151,6 @@ impl<'a> Cursor<'a> {
             Endian::Little => u64::from_le_bytes(a),
             Endian::Big => u64::from_be_bytes(a),
         })
-    }
-
-    pub fn f64(&mut self, e: Endian, what: &str) -> Result<f64, ReadError> {
-        Ok(f64::from_bits(self.u64(e, what)?))
     }
 
     /// `n` bytes of UTF-8 text.
