@@ -14,6 +14,8 @@
 //! [`ReadError`] that names the file, the channel and the byte offset; none panics on any
 //! input (each has a cargo-fuzz target in `fuzz/`).
 //!
+//! [`write_table`] writes a table back as NPZ, MAT level 5 or Parquet ([`write`]).
+//!
 //! Samples are passed through as stored: NaN and infinities are data here, and the
 //! identification pipeline checks finiteness. Integers convert to `f64` exactly or not at
 //! all ([`ReadError::InexactInteger`]).
@@ -36,8 +38,10 @@ pub mod table;
 pub mod tdms;
 pub mod uff;
 pub mod units;
+pub mod write;
 
 pub use error::ReadError;
 pub use format::{read_bytes, read_table, Format};
 pub use table::{Channel, Table, TimeAxis};
 pub use units::{Conversion, Quantity, UnitError};
+pub use write::{write_table, WriteError};
