@@ -14,7 +14,7 @@
 //! [`ReadError`] that names the file, the channel and the byte offset; none panics on any
 //! input (each has a cargo-fuzz target in `fuzz/`).
 //!
-//! [`write_table`] writes a table back as NPZ, MAT level 5 or Parquet ([`write`]).
+//! [`write_table`] writes a table back as NPZ, MAT level 5 or Parquet ([`mod@write`]).
 //!
 //! Samples are passed through as stored: NaN and infinities are data here, and the
 //! identification pipeline checks finiteness. Integers convert to `f64` exactly or not at
