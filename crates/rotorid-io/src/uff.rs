@@ -171,6 +171,15 @@ fn skip_dataset(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result
     Err(c.truncated("UFF closing \"    -1\"", 6))
 }
 
+/// A number, with a Fortran `D` exponent accepted.
+fn parse_number(w: &str) -> Option<f64> {
+    match w.parse::<f64>() {
+        Ok(v) => Some(v),
+        Err(_) if w.contains(['D', 'd']) => w.replace(['D', 'd'], "E").parse().ok(),
+        Err(_) => None,
+    }
+}
+
 fn field<'a>(
     c: &Cursor,
     at: usize,
@@ -331,7 +340,7 @@ fn dataset58(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<Ch
                 }
                 let text = std::str::from_utf8(l).map_err(|_| c.not_utf8(lat, "UFF 58 data", l))?;
                 for w in text.split_whitespace() {
-                    let v = w.replace(['D', 'd'], "E").parse::<f64>().map_err(|_| {
+                    let v = parse_number(w).ok_or_else(|| {
                         c.invalid_at(lat, "UFF 58 data value", format!("{w:?}"), "a number")
                     })?;
                     // Single precision data was written from f32 values.

@@ -81,7 +81,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
         match el.ty {
             MI_MATRIX => {
                 let mut sub = el.cursor(&c);
-                let var = matrix(&mut sub, endian, 0)?;
+                let var = matrix(&mut sub, endian, 0, None)?;
                 collect(var, &mut channels, &mut skipped);
             }
             MI_COMPRESSED => {
@@ -90,7 +90,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
                 let inner = tag(&mut ic, endian)?;
                 if inner.ty == MI_MATRIX {
                     let mut sub = inner.cursor(&ic);
-                    let var = matrix(&mut sub, endian, 0)?;
+                    let var = matrix(&mut sub, endian, 0, None)?;
                     collect(var, &mut channels, &mut skipped);
                 } else {
                     skipped.push(format!("a compressed element of type {}", inner.ty));
@@ -285,7 +285,8 @@ fn expect(c: &mut Cursor, e: Endian, tys: &[u32], what: &str) -> Result<Element,
 }
 
 /// Parses an `miMATRIX` element's data (the cursor spans exactly that data).
-fn matrix(c: &mut Cursor, e: Endian, depth: u32) -> Result<Var, ReadError> {
+/// `label` names a struct field (`rec.x`) in messages, whose own name is empty.
+fn matrix(c: &mut Cursor, e: Endian, depth: u32, label: Option<&str>) -> Result<Var, ReadError> {
     let flags_el = expect(c, e, &[MI_UINT32], "MAT array flags")?;
     if flags_el.len < 4 {
         return Err(c.invalid_at(
@@ -308,7 +309,8 @@ fn matrix(c: &mut Cursor, e: Endian, depth: u32) -> Result<Var, ReadError> {
     let mut nc = name_el.cursor(c);
     c.channel = None;
     let name = nc.utf8(name_el.len as u64, "MAT array name")?.to_string();
-    c.channel = Some(name.clone());
+    let shown = label.map_or_else(|| name.clone(), str::to_string);
+    c.channel = Some(shown.clone());
     if dims.len() < 2 || dims.iter().any(|&d| d < 0) {
         return Err(c.invalid_at(
             dims_el.at,
@@ -364,7 +366,8 @@ fn matrix(c: &mut Cursor, e: Endian, depth: u32) -> Result<Var, ReadError> {
                     .to_string();
                 let fel = expect(c, e, &[MI_MATRIX], "MAT struct field")?;
                 let mut fcur = fel.cursor(c);
-                fields.push(match matrix(&mut fcur, e, depth + 1)? {
+                let label = format!("{name}.{fname}");
+                fields.push(match matrix(&mut fcur, e, depth + 1, Some(&label))? {
                     Var::Vector { data, .. } => Var::Vector { name: fname, data },
                     Var::Skipped { why, .. } => Var::Skipped { name: fname, why },
                     Var::Struct { fields, .. } => Var::Struct {
@@ -402,7 +405,7 @@ fn matrix(c: &mut Cursor, e: Endian, depth: u32) -> Result<Var, ReadError> {
             if !vector {
                 return skip(format!("a {shape} {} matrix", class_name(class)));
             }
-            let data = c.samples(re.start, numel, t.size() as u64, t, e, &name)?;
+            let data = c.samples(re.start, numel, t.size() as u64, t, e, &shown)?;
             Ok(Var::Vector { name, data })
         }
     }
