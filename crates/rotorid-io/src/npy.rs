@@ -34,6 +34,12 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
         .unwrap_or("0");
     let mut c = Cursor::new(file, bytes);
     let channels = parse(&mut c, stem, false)?;
+    if channels.is_empty() {
+        return Err(ReadError::NoChannels {
+            file: file.to_string(),
+            why: "a 2-D array with no columns".into(),
+        });
+    }
     Ok(Table {
         file: file.to_string(),
         channels,

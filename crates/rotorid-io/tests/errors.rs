@@ -196,3 +196,11 @@ fn non_finite_samples_pass_through() {
     let d = &t.channels[0].data;
     assert!(d[5].is_nan() && d[6] == f64::INFINITY && d[7] == f64::NEG_INFINITY);
 }
+
+#[test]
+fn an_npy_without_columns_has_no_channels() {
+    // Found by the read_npy fuzz target: shape (0, 0) made an Ok table with no channel.
+    let b = npy("{'descr': '<f8', 'fortran_order': False, 'shape': (0, 0), }", &[]);
+    let e = read_bytes(Format::Npy, "empty.npy", &b).unwrap_err();
+    assert!(matches!(e, ReadError::NoChannels { .. }), "{e}");
+}
