@@ -204,3 +204,13 @@ fn an_npy_without_columns_has_no_channels() {
     let e = read_bytes(Format::Npy, "empty.npy", &b).unwrap_err();
     assert!(matches!(e, ReadError::NoChannels { .. }), "{e}");
 }
+
+#[test]
+fn a_uff_point_count_near_u64_max_is_truncated_not_an_overflow() {
+    // Found by the read_uff fuzz target: 2 * npts overflowed in the truncation message.
+    let mut b = fixture("rec.uff");
+    let i = b.windows(10).position(|w| w == b"       256").unwrap();
+    b[i..i + 10].copy_from_slice(b"    1.8e19");
+    let e = read_bytes(Format::Uff58, "rec.uff", &b).unwrap_err();
+    assert!(matches!(e, ReadError::Truncated { need: u64::MAX, .. }), "{e}");
+}
