@@ -13,7 +13,8 @@
 //! channels of `n` samples each, `0`, `1`, ... (`name.0`, ... in an NPZ), as a pandas
 //! `DataFrame.to_numpy()` is laid out: rows are samples, columns channels.
 //!
-//! Refused with an error naming the field: structured dtypes, complex, half, bool, strings,
+//! Refused with an error naming the field: more columns than the file has bytes (an empty
+//! `(0, m)` array could otherwise claim any number of channels), structured dtypes, complex, half, bool, strings,
 //! objects, datetimes, 3-D arrays, a data size that is not the shape's product (checked
 //! before allocating), 64-bit integers `f64` cannot hold exactly. The samples are
 //! dimensionless as far as the file knows (no unit); NaN and infinities pass through.
@@ -92,6 +93,19 @@ pub(crate) fn parse(c: &mut Cursor, name: &str, prefixed: bool) -> Result<Vec<Ch
             ))
         }
     };
+    // An empty array may claim any number of columns: each becomes a channel, so their
+    // number is bounded by the buffer's size.
+    if cols > c.data.len() as u64 {
+        return Err(c.invalid_at(
+            hpos,
+            "NPY shape",
+            format!("{:?}", h.shape),
+            format!(
+                "at most {} columns (the file's size in bytes)",
+                c.data.len()
+            ),
+        ));
+    }
     let size = dtype.size() as u64;
     let start = c.pos;
     let count = rows.checked_mul(cols).and_then(|n| n.checked_mul(size));

@@ -329,7 +329,10 @@ fn dataset58(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<Ch
         None => {
             let at = c.pos;
             if npts > c.remaining() as u64 / 2 {
-                return Err(c.truncated(&format!("UFF 58 data of {npts} points"), npts.saturating_mul(2)));
+                return Err(c.truncated(
+                    &format!("UFF 58 data of {npts} points"),
+                    npts.saturating_mul(2),
+                ));
             }
             let mut d = Vec::with_capacity(npts as usize);
             loop {

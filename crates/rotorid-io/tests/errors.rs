@@ -200,7 +200,10 @@ fn non_finite_samples_pass_through() {
 #[test]
 fn an_npy_without_columns_has_no_channels() {
     // Found by the read_npy fuzz target: shape (0, 0) made an Ok table with no channel.
-    let b = npy("{'descr': '<f8', 'fortran_order': False, 'shape': (0, 0), }", &[]);
+    let b = npy(
+        "{'descr': '<f8', 'fortran_order': False, 'shape': (0, 0), }",
+        &[],
+    );
     let e = read_bytes(Format::Npy, "empty.npy", &b).unwrap_err();
     assert!(matches!(e, ReadError::NoChannels { .. }), "{e}");
 }
@@ -212,5 +215,26 @@ fn a_uff_point_count_near_u64_max_is_truncated_not_an_overflow() {
     let i = b.windows(10).position(|w| w == b"       256").unwrap();
     b[i..i + 10].copy_from_slice(b"    1.8e19");
     let e = read_bytes(Format::Uff58, "rec.uff", &b).unwrap_err();
-    assert!(matches!(e, ReadError::Truncated { need: u64::MAX, .. }), "{e}");
+    assert!(
+        matches!(e, ReadError::Truncated { need: u64::MAX, .. }),
+        "{e}"
+    );
+}
+
+#[test]
+fn an_empty_npy_cannot_claim_endless_columns() {
+    // Found by the read_npy fuzz target: shape (0, 2.7e17) has no data but made as many
+    // empty channels, until the memory ran out.
+    let b = npy(
+        "{'descr': '<i4', 'fortran_order': False, 'shape': (0, 266666666666666606), }",
+        &[],
+    );
+    let e = read_bytes(Format::Npy, "wide.npy", &b).unwrap_err();
+    assert!(e.to_string().contains("at most 128 columns"), "{e}");
+    let b = npy(
+        "{'descr': '<i4', 'fortran_order': False, 'shape': (0, 3), }",
+        &[],
+    );
+    let t = read_bytes(Format::Npy, "three.npy", &b).unwrap();
+    assert_eq!(t.channels.len(), 3);
 }
