@@ -19,6 +19,7 @@ const FILES: &[(&str, Format)] = &[
     ("x_v73.mat", Format::Mat),
     ("x.tdms", Format::Tdms),
     ("x.uff", Format::Uff58),
+    ("x_ascii.uff", Format::Uff58),
     ("x.parquet", Format::Parquet),
 ];
 
