@@ -7,12 +7,43 @@
 //! for the role it plays (time, displacement, angle, speed, acceleration) and refuses a unit
 //! it does not know, naming the channel.
 //!
+//! [`read_table`] picks the reader by the file's extension ([`Format::from_path`]):
+//! [`mat`] (`.mat`, level 5 and v7.3), [`tdms`], [`uff`] (`.uff`, `.unv`, `.58`), [`npy`],
+//! [`npz`], [`parquet`]. CSV is read elsewhere. Every reader takes the whole file's bytes,
+//! checks each length and dimension field against them before allocating, and fails with a
+//! [`ReadError`] that names the file, the channel and the byte offset; none panics on any
+//! input (each has a cargo-fuzz target in `fuzz/`).
+//!
+//! [`write_table`] writes a table back as NPZ, MAT level 5 or Parquet ([`mod@write`]).
+//!
+//! Samples are passed through as stored: NaN and infinities are data here, and the
+//! identification pipeline checks finiteness. Integers convert to `f64` exactly or not at
+//! all ([`ReadError::InexactInteger`]).
+//!
 //! The crate does no identification: it turns bytes into SI samples and back.
 
+// ReadError carries the file, channel, offset, found and allowed values inline so callers can
+// match on them; it is returned once per failed read, so its size costs nothing measurable.
+#![allow(clippy::result_large_err)]
+
+mod cursor;
+pub mod error;
+pub mod format;
+pub mod mat;
+pub mod npy;
+pub mod npz;
+pub mod num;
+pub mod parquet;
 pub mod select;
 pub mod table;
+pub mod tdms;
+pub mod uff;
 pub mod units;
+pub mod write;
 
+pub use error::ReadError;
+pub use format::{read_bytes, read_table, Format};
 pub use select::{select, ColumnMap, SelectError, SiColumns};
 pub use table::{Channel, Table, TimeAxis};
 pub use units::{Conversion, Quantity, UnitError};
+pub use write::{write_table, WriteError};

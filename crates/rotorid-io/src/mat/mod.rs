@@ -1,0 +1,32 @@
+//! MATLAB `.mat` files: level 5 ([`v5`], what MATLAB writes with `-v6` and `-v7`, and
+//! `scipy.io.savemat`) and v7.3 ([`v73`], HDF5 with MATLAB conventions, `-v7.3`).
+//!
+//! Both yield the same channels: every top-level real numeric variable that is a vector
+//! (`1 x n`, `n x 1`, or a scalar) as a channel named after the variable, and each such
+//! field of a top-level scalar struct as `struct.field`. Any numeric class (double, single,
+//! int8..int64, uint8..uint64, logical) converts to `f64` exactly; a 64-bit integer `f64`
+//! cannot hold exactly is an error. Matrices, complex arrays, char, cell, sparse, object and
+//! struct-array variables are skipped (the error when nothing is left lists them). MAT
+//! files carry no units.
+//!
+//! Which of the two a file is follows from its 128-byte header: bytes 124..126 hold the
+//! version, `0x0100` for level 5 and `0x0200` for v7.3; a v7.3 file is an HDF5 file with a
+//! 512-byte user block holding that header. Level 4 files (no text header) are refused.
+
+pub mod v5;
+pub mod v73;
+
+use crate::error::ReadError;
+use crate::table::Table;
+
+/// Reads a `.mat` file's bytes, level 5 or v7.3 as its header says.
+pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
+    if bytes.len() >= 128 && bytes.starts_with(b"MATLAB") {
+        let v = [bytes[124], bytes[125]];
+        let hdf5 = bytes.get(512..520) == Some(b"\x89HDF\r\n\x1a\n".as_slice());
+        if v == [0x00, 0x02] || v == [0x02, 0x00] || hdf5 {
+            return v73::read(file, bytes);
+        }
+    }
+    v5::read(file, bytes)
+}

@@ -1,0 +1,101 @@
+//! NumPy `.npz` archives: a zip file (PKWARE APPNOTE 6.3) whose members `NAME.npy` are NPY
+//! arrays ([`crate::npy`]), stored (`numpy.savez`) or deflated (`numpy.savez_compressed`).
+//!
+//! Each member is one array: a 1-D array is the channel `NAME`, a 2-D array the channels
+//! `NAME.0`, `NAME.1`, ... (its columns). Members not ending in `.npy` are skipped.
+//!
+//! The zip directory is read by the `zip` crate (stored and deflate only; encrypted,
+//! bzip2, zstd and other methods are refused). A member's declared uncompressed size is
+//! checked before anything is allocated: at most its compressed size when stored, and at
+//! most 1032 times it (deflate's largest ratio) plus 1 KiB when deflated, so an archive
+//! cannot make the reader allocate more than about a thousand times its own size; the
+//! bytes actually inflated must equal the declared size.
+
+use std::io::Read;
+
+use crate::cursor::Cursor;
+use crate::error::ReadError;
+use crate::npy;
+use crate::table::Table;
+
+/// Deflate cannot expand more than this (RFC 1951: 258 bytes per two-bit code, ~1032:1).
+const MAX_DEFLATE_RATIO: u64 = 1032;
+
+/// Reads an `.npz` file's bytes; `file` names it in messages.
+pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
+    let zerr = |channel: Option<&str>, e: zip::result::ZipError| ReadError::Container {
+        file: file.to_string(),
+        channel: channel.map(str::to_string),
+        container: "zip",
+        message: e.to_string(),
+    };
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).map_err(|e| zerr(None, e))?;
+    let mut channels = Vec::new();
+    for i in 0..zip.len() {
+        let mut member = zip.by_index(i).map_err(|e| zerr(None, e))?;
+        let Some(name) = member.name().strip_suffix(".npy").map(str::to_string) else {
+            continue;
+        };
+        let at = member.header_start();
+        let (packed, size) = (member.compressed_size(), member.size());
+        let limit = match member.compression() {
+            zip::CompressionMethod::Stored => packed,
+            zip::CompressionMethod::Deflated => packed
+                .saturating_mul(MAX_DEFLATE_RATIO)
+                .saturating_add(1024),
+            m => {
+                return Err(ReadError::Invalid {
+                    file: file.to_string(),
+                    channel: Some(name),
+                    offset: at,
+                    what: "zip compression method".into(),
+                    found: m.to_string(),
+                    allowed: "stored or deflated (what numpy.savez and savez_compressed write)"
+                        .into(),
+                })
+            }
+        };
+        if size > limit || packed > bytes.len() as u64 {
+            return Err(ReadError::Invalid {
+                file: file.to_string(),
+                channel: Some(name),
+                offset: at,
+                what: "zip member size".into(),
+                found: format!("{size} bytes uncompressed from {packed} compressed"),
+                allowed: format!("at most {limit} (the file is {} bytes)", bytes.len()),
+            });
+        }
+        let mut buf = Vec::with_capacity(size as usize);
+        (&mut member)
+            .take(size + 1)
+            .read_to_end(&mut buf)
+            .map_err(|e| ReadError::Container {
+                file: file.to_string(),
+                channel: Some(name.clone()),
+                container: "zip",
+                message: format!("member at byte {at}: {e}"),
+            })?;
+        if buf.len() as u64 != size {
+            return Err(ReadError::Invalid {
+                file: file.to_string(),
+                channel: Some(name),
+                offset: at,
+                what: "zip member's inflated size".into(),
+                found: format!("{} bytes", buf.len()),
+                allowed: format!("the declared {size}"),
+            });
+        }
+        let mut c = Cursor::inflated(file, &buf, at);
+        channels.extend(npy::parse(&mut c, &name, true)?);
+    }
+    if channels.is_empty() {
+        return Err(ReadError::NoChannels {
+            file: file.to_string(),
+            why: "no member NAME.npy".into(),
+        });
+    }
+    Ok(Table {
+        file: file.to_string(),
+        channels,
+    })
+}

@@ -1,0 +1,214 @@
+//! Numeric element types shared by the binary readers, and their exact conversion to `f64`.
+//!
+//! Every integer type up to 32 bits and both float types convert exactly. A 64-bit integer
+//! converts only when `f64` holds it exactly (always for magnitudes up to 2^53); otherwise
+//! the read fails with [`ReadError::InexactInteger`] rather than rounding silently.
+//! Non-finite floats (NaN, ±inf) pass through as data: the readers do not judge samples,
+//! the identification pipeline checks finiteness.
+
+use crate::cursor::Cursor;
+use crate::error::ReadError;
+
+/// Byte order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Endian {
+    /// Least significant byte first.
+    Little,
+    /// Most significant byte first.
+    Big,
+}
+
+/// A numeric element type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dtype {
+    /// `i8`
+    I8,
+    /// `u8`
+    U8,
+    /// `i16`
+    I16,
+    /// `u16`
+    U16,
+    /// `i32`
+    I32,
+    /// `u32`
+    U32,
+    /// `i64`
+    I64,
+    /// `u64`
+    U64,
+    /// `f32`
+    F32,
+    /// `f64`
+    F64,
+}
+
+impl Dtype {
+    /// Bytes per element.
+    pub fn size(self) -> usize {
+        match self {
+            Dtype::I8 | Dtype::U8 => 1,
+            Dtype::I16 | Dtype::U16 => 2,
+            Dtype::I32 | Dtype::U32 | Dtype::F32 => 4,
+            Dtype::I64 | Dtype::U64 | Dtype::F64 => 8,
+        }
+    }
+}
+
+/// An integer that `f64` cannot hold exactly, at sample `index`.
+pub(crate) struct Inexact {
+    pub index: usize,
+    pub value: i128,
+}
+
+fn exact(v: i128, index: usize) -> Result<f64, Inexact> {
+    let f = v as f64;
+    // `f as i128` is exact for every f64 of magnitude below 2^127, which covers i64 and u64.
+    if f as i128 == v {
+        Ok(f)
+    } else {
+        Err(Inexact { index, value: v })
+    }
+}
+
+macro_rules! gather {
+    ($data:expr, $start:expr, $count:expr, $stride:expr, $n:literal, $e:expr, |$a:ident, $i:ident| $conv:expr) => {{
+        let mut out = Vec::with_capacity($count);
+        for $i in 0..$count {
+            let o = $start + $i * $stride;
+            let mut $a = [0u8; $n];
+            $a.copy_from_slice(&$data[o..o + $n]);
+            if $e == Endian::Big {
+                $a.reverse();
+            }
+            out.push($conv);
+        }
+        out
+    }};
+}
+
+/// Decodes `count` elements of type `t`, the first at `data[start]`, one every `stride`
+/// bytes. The caller has checked that they lie within `data`.
+fn gather(
+    data: &[u8],
+    start: usize,
+    count: usize,
+    stride: usize,
+    t: Dtype,
+    e: Endian,
+) -> Result<Vec<f64>, Inexact> {
+    Ok(match t {
+        Dtype::I8 => gather!(data, start, count, stride, 1, e, |a, i| a[0] as i8 as f64),
+        Dtype::U8 => gather!(data, start, count, stride, 1, e, |a, i| a[0] as f64),
+        Dtype::I16 => gather!(
+            data,
+            start,
+            count,
+            stride,
+            2,
+            e,
+            |a, i| i16::from_le_bytes(a) as f64
+        ),
+        Dtype::U16 => gather!(
+            data,
+            start,
+            count,
+            stride,
+            2,
+            e,
+            |a, i| u16::from_le_bytes(a) as f64
+        ),
+        Dtype::I32 => gather!(
+            data,
+            start,
+            count,
+            stride,
+            4,
+            e,
+            |a, i| i32::from_le_bytes(a) as f64
+        ),
+        Dtype::U32 => gather!(
+            data,
+            start,
+            count,
+            stride,
+            4,
+            e,
+            |a, i| u32::from_le_bytes(a) as f64
+        ),
+        Dtype::F32 => gather!(
+            data,
+            start,
+            count,
+            stride,
+            4,
+            e,
+            |a, i| f32::from_le_bytes(a) as f64
+        ),
+        Dtype::F64 => gather!(data, start, count, stride, 8, e, |a, i| f64::from_le_bytes(
+            a
+        )),
+        Dtype::I64 => {
+            let v = gather!(data, start, count, stride, 8, e, |a, i| exact(
+                i64::from_le_bytes(a) as i128,
+                i
+            ));
+            v.into_iter().collect::<Result<_, _>>()?
+        }
+        Dtype::U64 => {
+            let v = gather!(data, start, count, stride, 8, e, |a, i| exact(
+                u64::from_le_bytes(a) as i128,
+                i
+            ));
+            v.into_iter().collect::<Result<_, _>>()?
+        }
+    })
+}
+
+impl Cursor<'_> {
+    /// Decodes `count` elements of type `t` starting at buffer position `start`, one every
+    /// `stride` bytes, for `channel`. Checks the extent against the buffer before
+    /// allocating.
+    pub(crate) fn samples(
+        &self,
+        start: usize,
+        count: u64,
+        stride: u64,
+        t: Dtype,
+        e: Endian,
+        channel: &str,
+    ) -> Result<Vec<f64>, ReadError> {
+        let size = t.size() as u64;
+        let need = match count {
+            0 => Some(0),
+            // Never fewer bytes than `count` whole elements, whatever the stride: the
+            // allocation below is then bounded by the buffer.
+            n => (n - 1)
+                .checked_mul(stride.max(size))
+                .and_then(|x| x.checked_add(size)),
+        };
+        let avail = self.data.len().saturating_sub(start) as u64;
+        match need {
+            Some(n) if n <= avail => {}
+            other => {
+                return Err(ReadError::Truncated {
+                    file: self.file.to_string(),
+                    channel: Some(channel.to_string()),
+                    offset: self.offset_of(start),
+                    what: self.describe(&format!("{count} samples of {t:?}"), start),
+                    need: other.unwrap_or(u64::MAX),
+                    available: avail,
+                })
+            }
+        }
+        gather(self.data, start, count as usize, stride as usize, t, e).map_err(|x| {
+            ReadError::InexactInteger {
+                file: self.file.to_string(),
+                channel: channel.to_string(),
+                index: x.index,
+                offset: self.offset_of(start + x.index * stride as usize),
+                value: x.value,
+            }
+        })
+    }
+}

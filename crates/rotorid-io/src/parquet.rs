@@ -1,0 +1,429 @@
+//! Apache Parquet files (`.parquet`, as pandas and pyarrow write them), read with the
+//! `parquet` crate's column readers (no Arrow).
+//!
+//! Layout (Apache Parquet format specification, parquet-format 2.x): data, then the Thrift
+//! footer with the schema and row groups, its length, and the magic `PAR1`. Each top-level
+//! numeric column becomes a channel named after the column, its row groups concatenated in
+//! order. Physical types `DOUBLE`, `FLOAT`, `INT32` (signed, or unsigned by its
+//! `UINT_8/16/32` annotation) and `INT64` (signed or `UINT_64`; exact or an error) are
+//! read; any encoding (plain, dictionary, RLE, delta) and the codecs uncompressed, snappy
+//! (pyarrow's default) and gzip. Boolean, string, binary, `INT96`, decimal, date, time and
+//! timestamp columns, and nested columns, are skipped. A null is an error naming the column
+//! and row (the readers do not invent samples). Parquet carries no units.
+//!
+//! Bounds: before reading, the footer's row count must be at most 1032 times the file's
+//! size, and every page header of every column chunk is walked (Thrift compact protocol)
+//! to check that its compressed size lies within the file and its uncompressed size is at
+//! most 1032 times that plus 1 KiB, since the `parquet` crate allocates a page's claimed
+//! uncompressed size before decompressing. Errors of the `parquet` crate are reported as
+//! [`ReadError::Container`] with its message.
+
+use bytes::Bytes;
+use parquet::basic::{ConvertedType, Type as Physical};
+use parquet::column::reader::ColumnReader;
+use parquet::file::reader::{FileReader, SerializedFileReader};
+
+use crate::error::ReadError;
+use crate::table::{Channel, Table};
+
+const BATCH: usize = 65_536;
+
+/// Reads a Parquet file's bytes; `file` names it in messages.
+pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
+    let run = || read_inner(file, bytes);
+    // A third-party parser: a panic on a hostile file becomes an error here.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|_| {
+        Err(ReadError::Container {
+            file: file.to_string(),
+            channel: None,
+            container: "Parquet",
+            message: "the parquet reader failed on a malformed structure".into(),
+        })
+    })
+}
+
+fn err(file: &str, channel: Option<&str>, e: impl ToString) -> ReadError {
+    ReadError::Container {
+        file: file.to_string(),
+        channel: channel.map(str::to_string),
+        container: "Parquet",
+        message: e.to_string(),
+    }
+}
+
+/// How an integer column's values become `f64`.
+#[derive(Clone, Copy)]
+enum Kind {
+    Float,
+    Signed,
+    Unsigned,
+}
+
+fn read_inner(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
+    let reader =
+        SerializedFileReader::new(Bytes::copy_from_slice(bytes)).map_err(|e| err(file, None, e))?;
+    let meta = reader.metadata();
+    let schema = meta.file_metadata().schema_descr();
+    let rows: i64 = meta
+        .row_groups()
+        .iter()
+        .map(|g| g.num_rows().max(0))
+        .fold(0i64, i64::saturating_add);
+    let limit = (bytes.len() as u64).saturating_mul(1032);
+    if rows as u64 > limit {
+        return Err(ReadError::Invalid {
+            file: file.to_string(),
+            channel: None,
+            offset: 0,
+            what: "Parquet footer row count".into(),
+            found: rows.to_string(),
+            allowed: format!("at most {limit} (1032 times the file's size)"),
+        });
+    }
+    for g in meta.row_groups() {
+        for cc in g.columns() {
+            let start = cc.dictionary_page_offset().unwrap_or(cc.data_page_offset());
+            check_pages(
+                file,
+                bytes,
+                &cc.column_path().string(),
+                start,
+                cc.compressed_size(),
+            )?;
+        }
+    }
+    let mut channels = Vec::new();
+    let mut skipped = Vec::new();
+    for col in 0..schema.num_columns() {
+        let cd = schema.column(col);
+        let name = cd.path().string();
+        let kind = match (cd.physical_type(), cd.converted_type()) {
+            _ if cd.max_rep_level() > 0 || cd.path().parts().len() != 1 => None,
+            (Physical::DOUBLE | Physical::FLOAT, _) => Some(Kind::Float),
+            (
+                Physical::INT32 | Physical::INT64,
+                ConvertedType::NONE
+                | ConvertedType::INT_8
+                | ConvertedType::INT_16
+                | ConvertedType::INT_32
+                | ConvertedType::INT_64,
+            ) => Some(Kind::Signed),
+            (
+                Physical::INT32 | Physical::INT64,
+                ConvertedType::UINT_8
+                | ConvertedType::UINT_16
+                | ConvertedType::UINT_32
+                | ConvertedType::UINT_64,
+            ) => Some(Kind::Unsigned),
+            _ => None,
+        };
+        let Some(kind) = kind else {
+            skipped.push(format!(
+                "{name} ({} {})",
+                cd.physical_type(),
+                cd.converted_type()
+            ));
+            continue;
+        };
+        let max_def = cd.max_def_level();
+        let mut data: Vec<f64> = Vec::new();
+        for rg in 0..reader.num_row_groups() {
+            let group = reader
+                .get_row_group(rg)
+                .map_err(|e| err(file, Some(&name), e))?;
+            let mut col_reader = group
+                .get_column_reader(col)
+                .map_err(|e| err(file, Some(&name), e))?;
+            let mut defs: Vec<i16> = Vec::new();
+            let mut row0 = 0usize;
+            loop {
+                defs.clear();
+                let def = (max_def > 0).then_some(&mut defs);
+                let n = match &mut col_reader {
+                    ColumnReader::DoubleColumnReader(r) => {
+                        let mut v = Vec::new();
+                        let (recs, _, _) = r
+                            .read_records(BATCH, def, None, &mut v)
+                            .map_err(|e| err(file, Some(&name), e))?;
+                        data.extend(v);
+                        recs
+                    }
+                    ColumnReader::FloatColumnReader(r) => {
+                        let mut v = Vec::new();
+                        let (recs, _, _) = r
+                            .read_records(BATCH, def, None, &mut v)
+                            .map_err(|e| err(file, Some(&name), e))?;
+                        data.extend(v.into_iter().map(f64::from));
+                        recs
+                    }
+                    ColumnReader::Int32ColumnReader(r) => {
+                        let mut v = Vec::new();
+                        let (recs, _, _) = r
+                            .read_records(BATCH, def, None, &mut v)
+                            .map_err(|e| err(file, Some(&name), e))?;
+                        match kind {
+                            Kind::Unsigned => {
+                                data.extend(v.into_iter().map(|x| f64::from(x as u32)))
+                            }
+                            _ => data.extend(v.into_iter().map(f64::from)),
+                        }
+                        recs
+                    }
+                    ColumnReader::Int64ColumnReader(r) => {
+                        let mut v = Vec::new();
+                        let (recs, _, _) = r
+                            .read_records(BATCH, def, None, &mut v)
+                            .map_err(|e| err(file, Some(&name), e))?;
+                        for x in v {
+                            let wide = match kind {
+                                Kind::Unsigned => i128::from(x as u64),
+                                _ => i128::from(x),
+                            };
+                            let f = wide as f64;
+                            if f as i128 != wide {
+                                return Err(ReadError::InexactInteger {
+                                    file: file.to_string(),
+                                    channel: name,
+                                    index: data.len(),
+                                    offset: 0,
+                                    value: wide,
+                                });
+                            }
+                            data.push(f);
+                        }
+                        recs
+                    }
+                    _ => return Err(err(file, Some(&name), "unexpected column reader")),
+                };
+                if let Some(i) = defs.iter().position(|&d| d < max_def) {
+                    return Err(ReadError::Invalid {
+                        file: file.to_string(),
+                        channel: Some(name),
+                        offset: 0,
+                        what: format!("Parquet row {} of row group {rg}", row0 + i),
+                        found: "a null".into(),
+                        allowed: "a value in every row".into(),
+                    });
+                }
+                if n == 0 {
+                    break;
+                }
+                row0 += n;
+                if data.len() as u64 > limit {
+                    return Err(err(file, Some(&name), format!("more than {limit} values")));
+                }
+            }
+        }
+        channels.push(Channel {
+            name,
+            unit: None,
+            data,
+            axis: None,
+        });
+    }
+    if channels.is_empty() {
+        return Err(ReadError::NoChannels {
+            file: file.to_string(),
+            why: if skipped.is_empty() {
+                "no columns".into()
+            } else {
+                format!("skipped: {}", skipped.join(", "))
+            },
+        });
+    }
+    Ok(Table {
+        file: file.to_string(),
+        channels,
+    })
+}
+
+/// Walks the page headers of a column chunk of `len` bytes at `start`, checking each page's
+/// sizes before the `parquet` crate allocates them.
+fn check_pages(
+    file: &str,
+    bytes: &[u8],
+    name: &str,
+    start: i64,
+    len: i64,
+) -> Result<(), ReadError> {
+    let bad = |offset: u64, found: String, allowed: String| ReadError::Invalid {
+        file: file.to_string(),
+        channel: Some(name.to_string()),
+        offset,
+        what: "Parquet page".into(),
+        found,
+        allowed,
+    };
+    let (Ok(start), Ok(len)) = (u64::try_from(start), u64::try_from(len)) else {
+        return Err(bad(
+            0,
+            format!("a column chunk at {start} of {len} bytes"),
+            "non-negative offsets".into(),
+        ));
+    };
+    let end = start
+        .checked_add(len)
+        .filter(|&e| e <= bytes.len() as u64)
+        .ok_or_else(|| {
+            bad(
+                start,
+                format!("a column chunk of {len} bytes"),
+                format!("one within the file's {} bytes", bytes.len()),
+            )
+        })?;
+    let mut pos = start;
+    while pos < end {
+        let mut t = Thrift {
+            b: &bytes[..end as usize],
+            i: pos as usize,
+        };
+        let (unc, comp) = t.page_header().ok_or_else(|| {
+            bad(
+                pos,
+                "a malformed page header".into(),
+                "a Thrift compact PageHeader".into(),
+            )
+        })?;
+        let (Ok(unc), Ok(comp)) = (u64::try_from(unc), u64::try_from(comp)) else {
+            return Err(bad(
+                pos,
+                format!("page sizes {unc} and {comp}"),
+                "non-negative sizes".into(),
+            ));
+        };
+        let data = t.i as u64;
+        if comp > end - data {
+            return Err(bad(
+                pos,
+                format!("a page of {comp} compressed bytes"),
+                format!("at most the {} left in its column chunk", end - data),
+            ));
+        }
+        let limit = comp.saturating_mul(1032).saturating_add(1024);
+        if unc > limit {
+            return Err(bad(
+                pos,
+                format!("{unc} uncompressed bytes from {comp}"),
+                format!("at most {limit}"),
+            ));
+        }
+        pos = data + comp;
+    }
+    Ok(())
+}
+
+/// Just enough of the Thrift compact protocol to read a PageHeader's sizes (fields 2 and 3)
+/// and step over the rest.
+struct Thrift<'a> {
+    b: &'a [u8],
+    i: usize,
+}
+
+impl Thrift<'_> {
+    fn byte(&mut self) -> Option<u8> {
+        let v = *self.b.get(self.i)?;
+        self.i += 1;
+        Some(v)
+    }
+    fn varint(&mut self) -> Option<u64> {
+        let mut v = 0u64;
+        for shift in (0..64).step_by(7) {
+            let b = self.byte()?;
+            v |= u64::from(b & 0x7f) << shift;
+            if b & 0x80 == 0 {
+                return Some(v);
+            }
+        }
+        None
+    }
+    fn zigzag(&mut self) -> Option<i64> {
+        let v = self.varint()?;
+        Some((v >> 1) as i64 ^ -((v & 1) as i64))
+    }
+    fn skip(&mut self, ty: u8, depth: u32) -> Option<()> {
+        if depth > 32 {
+            return None;
+        }
+        match ty {
+            1 | 2 => {}
+            3 => self.i = self.i.checked_add(1)?,
+            4..=6 => {
+                self.varint()?;
+            }
+            7 => self.i = self.i.checked_add(8)?,
+            8 => {
+                let n = usize::try_from(self.varint()?).ok()?;
+                self.i = self.i.checked_add(n)?;
+            }
+            9 | 10 => {
+                let h = self.byte()?;
+                let n = match h >> 4 {
+                    15 => self.varint()?,
+                    n => u64::from(n),
+                };
+                for _ in 0..n {
+                    // A boolean in a list is one byte.
+                    if h & 0x0f <= 2 {
+                        self.byte()?;
+                    } else {
+                        self.skip(h & 0x0f, depth + 1)?;
+                    }
+                }
+            }
+            11 => {
+                let n = self.varint()?;
+                if n > 0 {
+                    let kv = self.byte()?;
+                    for _ in 0..n {
+                        self.skip(kv >> 4, depth + 1)?;
+                        self.skip(kv & 0x0f, depth + 1)?;
+                    }
+                }
+            }
+            12 => {
+                self.fields(depth + 1, |_, _, _| Some(false))?;
+            }
+            _ => return None,
+        }
+        (self.i <= self.b.len()).then_some(())
+    }
+    /// Reads a struct's fields, giving `f` the chance to read each (it returns whether it
+    /// did); the others are skipped.
+    fn fields(
+        &mut self,
+        depth: u32,
+        mut f: impl FnMut(&mut Self, i16, u8) -> Option<bool>,
+    ) -> Option<()> {
+        let mut id: i16 = 0;
+        loop {
+            let h = self.byte()?;
+            if h == 0 {
+                return Some(());
+            }
+            let ty = h & 0x0f;
+            id = match h >> 4 {
+                0 => i16::try_from(self.zigzag()?).ok()?,
+                d => id.checked_add(i16::from(d))?,
+            };
+            if !f(self, id, ty)? {
+                self.skip(ty, depth)?;
+            }
+        }
+    }
+    /// A PageHeader's uncompressed and compressed sizes.
+    fn page_header(&mut self) -> Option<(i64, i64)> {
+        let (mut unc, mut comp) = (None, None);
+        self.fields(0, |t, id, ty| match (id, ty) {
+            (2, 5) => {
+                unc = Some(t.zigzag()?);
+                Some(true)
+            }
+            (3, 5) => {
+                comp = Some(t.zigzag()?);
+                Some(true)
+            }
+            _ => Some(false),
+        })?;
+        Some((unc?, comp?))
+    }
+}

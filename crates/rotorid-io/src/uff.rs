@@ -1,0 +1,398 @@
+//! Universal File Format dataset 58 ("function at nodal DOF"), ASCII and binary (58b), in
+//! `.uff`, `.unv` or `.58` files as modal and test software (Siemens Testlab, ME'scope,
+//! pyuff) write them.
+//!
+//! Layout, after the SDRC/Siemens "Universal Dataset Number 58" description (as reproduced
+//! in pyuff's `dataset_58.py`): a dataset is delimited by lines `    -1`; its first line is
+//! the dataset number (`    58`, or `    58b` followed by the byte order (1 little, 2 big
+//! endian), the floating-point format (2: IEEE 754), the number of ASCII header lines (11)
+//! and the number of binary data bytes). Records 1-5 are ID lines (record 1 names the
+//! channel here); record 6 the function type and nodes; record 7 (`3I10,3E13.5`) the
+//! ordinate data type (2 real single, 4 real double, 5 complex single, 6 complex double),
+//! the number of points, the abscissa spacing (1 even, 0 uneven), the abscissa minimum and
+//! increment; records 8-11 (`I10,3I5,2(1X,20A1)`) the abscissa, ordinate numerator,
+//! ordinate denominator and z-axis characteristics: a data type (abscissa: 17 time, 0
+//! unknown), unit exponents, an axis label (columns 27-46) and a units label (columns
+//! 48-67). Record 12 is the data: ASCII numbers (`E13.5` or `E20.12`, whitespace
+//! separated, Fortran `D` exponents accepted) or, in 58b, the raw IEEE numbers.
+//!
+//! Each dataset 58 becomes a channel named by its ID line 1 (trimmed; a repeated name gets
+//! `#2`, `#3`, ...), with unit the ordinate units label (`num/den` when the denominator has
+//! one; `NONE` or blank is no unit) and the time axis start and increment \[s\] of record
+//! 7. Other datasets (units 164, header 151, nodes 15/2411, ...) are skipped. Refused with an
+//! error naming the channel and byte offset: complex data (FRFs: not a time record),
+//! uneven abscissa spacing, an abscissa that is not time, a point count that differs from
+//! the data, binary formats other than IEEE 754, non-UTF-8 header text.
+
+use crate::cursor::Cursor;
+use crate::error::ReadError;
+use crate::num::{Dtype, Endian};
+use crate::table::{Channel, Table, TimeAxis};
+
+/// Reads a UFF file's bytes; `file` names it in messages.
+pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
+    let mut c = Cursor::new(file, bytes);
+    let mut channels: Vec<Channel> = Vec::new();
+    let mut other = Vec::new();
+    loop {
+        // Find the next "-1" delimiter, skipping blank lines.
+        let (at, l) = match line(&mut c) {
+            None => break,
+            Some(x) => x,
+        };
+        let t = trim(l);
+        if t.is_empty() {
+            continue;
+        }
+        if t != b"-1" {
+            return Err(c.invalid_at(at, "UFF dataset delimiter", show(l), "a line \"    -1\""));
+        }
+        let (hat, head) = line(&mut c).ok_or_else(|| c.truncated("UFF dataset number", 6))?;
+        let num = trim(head.get(..6).unwrap_or(head));
+        let binary = head.get(6) == Some(&b'b');
+        if num == b"-1" || num.is_empty() {
+            // An empty dataset or a stray delimiter: the next line starts over.
+            c.pos = hat;
+            continue;
+        }
+        if num == b"58" {
+            let ch = dataset58(&mut c, hat, head, binary)?;
+            let mut name = ch.name.clone();
+            let mut k = 1;
+            while channels.iter().any(|x| x.name == name) {
+                k += 1;
+                name = format!("{}#{k}", ch.name);
+            }
+            channels.push(Channel { name, ..ch });
+        } else {
+            other.push(String::from_utf8_lossy(num).into_owned());
+            skip_dataset(&mut c, hat, head, binary)?;
+        }
+    }
+    if channels.is_empty() {
+        return Err(ReadError::NoChannels {
+            file: file.to_string(),
+            why: if other.is_empty() {
+                "no UFF dataset".into()
+            } else {
+                format!("only datasets {}", other.join(", "))
+            },
+        });
+    }
+    Ok(Table {
+        file: file.to_string(),
+        channels,
+    })
+}
+
+fn show(l: &[u8]) -> String {
+    format!("{:?}", String::from_utf8_lossy(&l[..l.len().min(40)]))
+}
+
+fn trim(l: &[u8]) -> &[u8] {
+    l.trim_ascii()
+}
+
+/// The next line (without `\n` or `\r\n`) and its buffer position; `None` at the end.
+fn line<'a>(c: &mut Cursor<'a>) -> Option<(usize, &'a [u8])> {
+    if c.at_end() {
+        return None;
+    }
+    let at = c.pos;
+    let rest = &c.data[at..];
+    let n = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+    c.pos = (at + n + 1).min(c.data.len());
+    let l = &rest[..n];
+    Some((at, l.strip_suffix(b"\r").unwrap_or(l)))
+}
+
+/// The 58b header fields after `58b`: byte order, float format, ASCII lines, data bytes.
+fn binary_header(c: &Cursor, hat: usize, head: &[u8]) -> Result<(Endian, u64, u64), ReadError> {
+    let text = std::str::from_utf8(head.get(7..).unwrap_or(b""))
+        .map_err(|_| c.not_utf8(hat, "UFF binary header", head))?;
+    let f: Vec<u64> = text
+        .split_whitespace()
+        .take(4)
+        .map(|w| w.parse::<u64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| {
+            c.invalid_at(
+                hat,
+                "UFF binary header",
+                show(head),
+                "byte order, float format, ASCII line count, byte count as integers",
+            )
+        })?;
+    if f.len() < 4 {
+        return Err(c.invalid_at(
+            hat,
+            "UFF binary header",
+            show(head),
+            "byte order, float format, ASCII line count, byte count",
+        ));
+    }
+    let e = match f[0] {
+        1 => Endian::Little,
+        2 => Endian::Big,
+        o => {
+            return Err(c.invalid_at(
+                hat,
+                "UFF binary byte order",
+                o,
+                "1 (little endian) or 2 (big endian)",
+            ))
+        }
+    };
+    if f[1] != 2 {
+        return Err(c.invalid_at(
+            hat,
+            "UFF binary floating-point format",
+            f[1],
+            "2 (IEEE 754)",
+        ));
+    }
+    Ok((e, f[2], f[3]))
+}
+
+/// Steps over a dataset other than 58, up to and including its closing `-1`.
+fn skip_dataset(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<(), ReadError> {
+    if binary {
+        let (_, lines, nbytes) = binary_header(c, hat, head)?;
+        for _ in 0..lines {
+            line(c).ok_or_else(|| c.truncated("UFF binary dataset header line", 1))?;
+        }
+        c.skip(nbytes, "UFF binary dataset data")?;
+    }
+    while let Some((_, l)) = line(c) {
+        if trim(l) == b"-1" {
+            return Ok(());
+        }
+    }
+    Err(c.truncated("UFF closing \"    -1\"", 6))
+}
+
+/// A number, with a Fortran `D` exponent accepted.
+fn parse_number(w: &str) -> Option<f64> {
+    match w.parse::<f64>() {
+        Ok(v) => Some(v),
+        Err(_) if w.contains(['D', 'd']) => w.replace(['D', 'd'], "E").parse().ok(),
+        Err(_) => None,
+    }
+}
+
+fn field<'a>(
+    c: &Cursor,
+    at: usize,
+    l: &'a [u8],
+    from: usize,
+    to: usize,
+    what: &str,
+) -> Result<&'a str, ReadError> {
+    let b = l.get(from.min(l.len())..to.min(l.len())).unwrap_or(b"");
+    std::str::from_utf8(b)
+        .map(str::trim)
+        .map_err(|_| c.not_utf8(at + from, what, b))
+}
+
+fn numbers<T: std::str::FromStr>(
+    c: &Cursor,
+    at: usize,
+    l: &[u8],
+    n: usize,
+    what: &str,
+    allowed: &str,
+) -> Result<Vec<T>, ReadError> {
+    let text = std::str::from_utf8(l).map_err(|_| c.not_utf8(at, what, l))?;
+    let v: Vec<T> = text
+        .split_whitespace()
+        .take(n)
+        .map(|w| w.replace(['D', 'd'], "E").parse::<T>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| c.invalid_at(at, what, show(l), allowed))?;
+    if v.len() < n {
+        return Err(c.invalid_at(at, what, show(l), allowed));
+    }
+    Ok(v)
+}
+
+fn units(c: &Cursor, at: usize, l: &[u8], what: &str) -> Result<Option<String>, ReadError> {
+    let u = field(c, at, l, 47, 67, what)?;
+    Ok((!u.is_empty() && !u.eq_ignore_ascii_case("NONE")).then(|| u.to_string()))
+}
+
+fn dataset58(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<Channel, ReadError> {
+    let bin = if binary {
+        Some(binary_header(c, hat, head)?)
+    } else {
+        None
+    };
+    if let Some((_, lines, _)) = bin {
+        if lines != 11 {
+            return Err(c.invalid_at(hat, "UFF 58b ASCII line count", lines, "11"));
+        }
+    }
+    let mut rec = Vec::with_capacity(11);
+    for k in 1..=11 {
+        rec.push(line(c).ok_or_else(|| c.truncated(&format!("UFF 58 record {k}"), 1))?);
+    }
+    let (at1, id1) = rec[0];
+    let mut name = field(c, at1, id1, 0, 80, "UFF 58 ID line 1 (the channel name)")?.to_string();
+    if name.is_empty() {
+        name = format!("58@{hat}");
+    }
+    c.channel = Some(name.clone());
+    let (at7, r7) = rec[6];
+    let head7: Vec<f64> = numbers(
+        c,
+        at7,
+        r7,
+        5,
+        "UFF 58 record 7",
+        "ordinate type, point count, spacing, abscissa minimum and increment",
+    )?;
+    let (ord, npts, spacing, start, inc) = (head7[0], head7[1], head7[2], head7[3], head7[4]);
+    let dtype = match ord as i64 {
+        2 => Dtype::F32,
+        4 => Dtype::F64,
+        5 | 6 => {
+            return Err(c.invalid_at(
+                at7,
+                "UFF 58 ordinate data type",
+                format!("{ord} (complex)"),
+                "2 or 4 (real single or double: a time record)",
+            ))
+        }
+        _ => {
+            return Err(c.invalid_at(
+                at7,
+                "UFF 58 ordinate data type",
+                ord,
+                "2 or 4 (real single or double)",
+            ))
+        }
+    };
+    if spacing != 1.0 {
+        return Err(c.invalid_at(
+            at7,
+            "UFF 58 abscissa spacing",
+            spacing,
+            "1 (even; uneven abscissae are not read)",
+        ));
+    }
+    if !(inc > 0.0 && inc.is_finite() && start.is_finite()) {
+        return Err(c.invalid_at(
+            at7,
+            "UFF 58 abscissa increment",
+            inc,
+            "a positive finite number of seconds",
+        ));
+    }
+    if !(npts >= 0.0 && npts.fract() == 0.0) {
+        return Err(c.invalid_at(at7, "UFF 58 number of points", npts, "a whole number"));
+    }
+    let (at8, r8) = rec[7];
+    let xtype = field(c, at8, r8, 0, 10, "UFF 58 abscissa data type")?;
+    if !matches!(xtype, "0" | "17" | "") {
+        return Err(c.invalid_at(
+            at8,
+            "UFF 58 abscissa data type",
+            xtype,
+            "17 (time) or 0 (unknown)",
+        ));
+    }
+    let (at9, r9) = rec[8];
+    let (at10, r10) = rec[9];
+    let unit = match (
+        units(c, at9, r9, "UFF 58 ordinate units")?,
+        units(c, at10, r10, "UFF 58 ordinate denominator units")?,
+    ) {
+        (Some(n), Some(d)) => Some(format!("{n}/{d}")),
+        (n, _) => n,
+    };
+    let npts = npts as u64;
+    let data = match bin {
+        Some((e, _, nbytes)) => {
+            let size = dtype.size() as u64;
+            if npts.checked_mul(size) != Some(nbytes) {
+                return Err(c.invalid_at(
+                    hat,
+                    "UFF 58b byte count",
+                    nbytes,
+                    format!("{npts} points of {size} bytes"),
+                ));
+            }
+            let start_pos = c.pos;
+            let d = c.samples(start_pos, npts, size, dtype, e, &name)?;
+            c.pos += nbytes as usize;
+            d
+        }
+        None => {
+            let at = c.pos;
+            if npts > c.remaining() as u64 / 2 {
+                return Err(c.truncated(
+                    &format!("UFF 58 data of {npts} points"),
+                    npts.saturating_mul(2),
+                ));
+            }
+            let mut d = Vec::with_capacity(npts as usize);
+            loop {
+                let (lat, l) = line(c).ok_or_else(|| c.truncated("UFF closing \"    -1\"", 6))?;
+                if trim(l) == b"-1" {
+                    c.pos = lat;
+                    break;
+                }
+                let text = std::str::from_utf8(l).map_err(|_| c.not_utf8(lat, "UFF 58 data", l))?;
+                for w in text.split_whitespace() {
+                    let v = parse_number(w).ok_or_else(|| {
+                        c.invalid_at(lat, "UFF 58 data value", format!("{w:?}"), "a number")
+                    })?;
+                    // Single precision data was written from f32 values.
+                    d.push(v);
+                    if d.len() as u64 > npts {
+                        return Err(c.invalid_at(
+                            at,
+                            "UFF 58 data",
+                            "more values than points",
+                            format!("{npts} points"),
+                        ));
+                    }
+                }
+            }
+            if d.len() as u64 != npts {
+                return Err(c.invalid_at(
+                    at,
+                    "UFF 58 data",
+                    format!("{} values", d.len()),
+                    format!("{npts} points"),
+                ));
+            }
+            d
+        }
+    };
+    // The closing delimiter, possibly after the newline ending the binary data.
+    loop {
+        let (lat, l) = line(c).ok_or_else(|| c.truncated("UFF closing \"    -1\"", 6))?;
+        match trim(l) {
+            b"" => continue,
+            b"-1" => break,
+            _ => {
+                return Err(c.invalid_at(
+                    lat,
+                    "UFF 58 end",
+                    show(l),
+                    "a line \"    -1\" after the data",
+                ))
+            }
+        }
+    }
+    c.channel = None;
+    Ok(Channel {
+        name,
+        unit,
+        data,
+        axis: Some(TimeAxis {
+            start,
+            increment: inc,
+        }),
+    })
+}

@@ -1,0 +1,240 @@
+//! What the errors say: the file, the channel, the byte offset, what was found and allowed.
+
+use std::path::Path;
+
+use rotorid_io::{read_bytes, Format, ReadError};
+
+fn fixture(name: &str) -> Vec<u8> {
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fixtures")
+            .join(name),
+    )
+    .unwrap()
+}
+
+fn patch(bytes: &mut [u8], find: &[u8], at: usize, with: u8) -> usize {
+    let i = bytes
+        .windows(find.len())
+        .position(|w| w == find)
+        .expect("pattern in fixture");
+    bytes[i + at] = with;
+    i + at
+}
+
+fn npy(header: &str, data: &[u8]) -> Vec<u8> {
+    let mut h = header.to_string();
+    while (10 + h.len() + 1) % 64 != 0 {
+        h.push(' ');
+    }
+    h.push('\n');
+    let mut b = b"\x93NUMPY\x01\x00".to_vec();
+    b.extend((h.len() as u16).to_le_bytes());
+    b.extend(h.as_bytes());
+    b.extend(data);
+    b
+}
+
+#[test]
+fn a_dimension_larger_than_the_file_is_refused_before_allocating() {
+    let b = npy(
+        "{'descr': '<f8', 'fortran_order': False, 'shape': (1000000000000,), }",
+        &[0; 16],
+    );
+    let e = read_bytes(Format::Npy, "big.npy", &b).unwrap_err();
+    match &e {
+        ReadError::Truncated {
+            file,
+            channel,
+            offset,
+            need,
+            available,
+            ..
+        } => {
+            assert_eq!(file, "big.npy");
+            assert_eq!(channel.as_deref(), Some("big"));
+            assert_eq!(
+                (*offset, *need, *available),
+                (b.len() as u64 - 16, 8_000_000_000_000, 16)
+            );
+        }
+        other => panic!("{other}"),
+    }
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with("big.npy, channel \"big\": ")
+            && msg.contains(&format!("at byte {}", b.len() - 16)),
+        "{msg}"
+    );
+}
+
+#[test]
+fn an_inexact_int64_names_its_sample() {
+    let e = read_bytes(Format::Npy, "inexact_i8.npy", &fixture("inexact_i8.npy")).unwrap_err();
+    match e {
+        ReadError::InexactInteger {
+            channel,
+            index,
+            offset,
+            value,
+            ..
+        } => {
+            assert_eq!(
+                (channel.as_str(), index, value),
+                ("inexact_i8", 1, (1i128 << 53) + 1)
+            );
+            assert_eq!(offset, 128 + 8);
+        }
+        other => panic!("{other}"),
+    }
+    let e = read_bytes(Format::Mat, "inexact_v5.mat", &fixture("inexact_v5.mat")).unwrap_err();
+    assert!(
+        matches!(e, ReadError::InexactInteger { ref channel, index: 0, .. } if channel == "n"),
+        "{e}"
+    );
+}
+
+#[test]
+fn names_that_are_not_utf8_are_refused_with_their_offset() {
+    let mut b = fixture("rec_v5.mat");
+    let at = patch(&mut b, b"\x01\x00\x01\x00t\x00", 4, 0xff);
+    let e = read_bytes(Format::Mat, "rec_v5.mat", &b).unwrap_err();
+    assert!(
+        matches!(e, ReadError::NotUtf8 { offset, .. } if offset == at as u64),
+        "{e} (name at {at})"
+    );
+
+    let mut b = fixture("rec.tdms");
+    let at = patch(&mut b, b"/'bearing1'/'x'", 13, 0xff);
+    let e = read_bytes(Format::Tdms, "rec.tdms", &b).unwrap_err();
+    assert!(
+        matches!(e, ReadError::NotUtf8 { offset, .. } if offset == at as u64 - 13 ),
+        "{e} (path at {})",
+        at - 13
+    );
+
+    let mut b = fixture("rec.uff");
+    let at = patch(&mut b, b"\nx      ", 1, 0xe9);
+    let e = read_bytes(Format::Uff58, "rec.uff", &b).unwrap_err();
+    assert!(
+        matches!(e, ReadError::NotUtf8 { offset, .. } if offset == at as u64),
+        "{e} (ID line at {at})"
+    );
+}
+
+#[test]
+fn a_truncated_tdms_segment_names_the_segment() {
+    let b = fixture("rec.tdms");
+    let e = read_bytes(Format::Tdms, "rec.tdms", &b[..b.len() - 1]).unwrap_err();
+    match e {
+        ReadError::Truncated {
+            what,
+            offset,
+            need,
+            available,
+            ..
+        } => {
+            assert_eq!(what, "TDMS segment");
+            assert!(
+                offset > 0 && need == available + 1,
+                "{offset} {need} {available}"
+            );
+        }
+        other => panic!("{other}"),
+    }
+}
+
+#[test]
+fn complex_uff_is_refused_naming_the_channel() {
+    let e = read_bytes(Format::Uff58, "frf.uff", &fixture("frf_complex.uff")).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains("channel \"H\"") && msg.contains("complex") && msg.contains("allowed: 2 or 4"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn parquet_nulls_are_refused_naming_the_row() {
+    let e = read_bytes(Format::Parquet, "nulls.parquet", &fixture("nulls.parquet")).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains("channel \"x\"") && msg.contains("row 1 of row group 0"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn skipped_variables_are_listed_when_nothing_is_left() {
+    // The header and the variables M (a matrix), c (complex) and note (char) of rec_v5.mat:
+    // NoChannels lists them.
+    let b = fixture("rec_v5.mat");
+    let (mut pos, mut elements) = (128, vec![]);
+    while pos < b.len() {
+        let n = u32::from_le_bytes(b[pos + 4..pos + 8].try_into().unwrap()) as usize;
+        elements.push(pos..pos + 8 + n.div_ceil(8) * 8);
+        pos += 8 + n.div_ceil(8) * 8;
+    }
+    let mut m = b[..128].to_vec();
+    for k in 6..9 {
+        m.extend(&b[elements[k].clone()]);
+    }
+    let e = read_bytes(Format::Mat, "m.mat", &m).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, ReadError::NoChannels { .. }), "{msg}");
+    assert!(
+        msg.contains("M: a 3x4 double matrix")
+            && msg.contains("c: a complex 256x1 double")
+            && msg.contains("note: a 1x21 char"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn non_finite_samples_pass_through() {
+    let t = read_bytes(Format::Npy, "sine.npy", &fixture("sine.npy")).unwrap();
+    let d = &t.channels[0].data;
+    assert!(d[5].is_nan() && d[6] == f64::INFINITY && d[7] == f64::NEG_INFINITY);
+}
+
+#[test]
+fn an_npy_without_columns_has_no_channels() {
+    // Found by the read_npy fuzz target: shape (0, 0) made an Ok table with no channel.
+    let b = npy(
+        "{'descr': '<f8', 'fortran_order': False, 'shape': (0, 0), }",
+        &[],
+    );
+    let e = read_bytes(Format::Npy, "empty.npy", &b).unwrap_err();
+    assert!(matches!(e, ReadError::NoChannels { .. }), "{e}");
+}
+
+#[test]
+fn a_uff_point_count_near_u64_max_is_truncated_not_an_overflow() {
+    // Found by the read_uff fuzz target: 2 * npts overflowed in the truncation message.
+    let mut b = fixture("rec.uff");
+    let i = b.windows(10).position(|w| w == b"       256").unwrap();
+    b[i..i + 10].copy_from_slice(b"    1.8e19");
+    let e = read_bytes(Format::Uff58, "rec.uff", &b).unwrap_err();
+    assert!(
+        matches!(e, ReadError::Truncated { need: u64::MAX, .. }),
+        "{e}"
+    );
+}
+
+#[test]
+fn an_empty_npy_cannot_claim_endless_columns() {
+    // Found by the read_npy fuzz target: shape (0, 2.7e17) has no data but made as many
+    // empty channels, until the memory ran out.
+    let b = npy(
+        "{'descr': '<i4', 'fortran_order': False, 'shape': (0, 266666666666666606), }",
+        &[],
+    );
+    let e = read_bytes(Format::Npy, "wide.npy", &b).unwrap_err();
+    assert!(e.to_string().contains("at most 128 columns"), "{e}");
+    let b = npy(
+        "{'descr': '<i4', 'fortran_order': False, 'shape': (0, 3), }",
+        &[],
+    );
+    let t = read_bytes(Format::Npy, "three.npy", &b).unwrap();
+    assert_eq!(t.channels.len(), 3);
+}

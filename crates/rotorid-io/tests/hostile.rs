@@ -1,0 +1,154 @@
+//! Hostile files: every fixture truncated at many offsets, with bytes flipped, with length
+//! fields blown up. A reader may refuse (with an error naming the file) but never panic,
+//! hang, or allocate beyond the file's size (the fuzz targets in fuzz/ go further).
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use rotorid_io::{read_bytes, Format};
+
+/// Records the largest single allocation made by this thread since the last reset.
+struct Peak;
+
+thread_local! {
+    static PEAK: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Peak {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = PEAK.try_with(|p| p.set(p.get().max(layout.size())));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = PEAK.try_with(|p| p.set(p.get().max(new_size)));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOC: Peak = Peak;
+
+/// The largest allocation a read of `len` bytes may make: 8 bytes of `f64` per input byte
+/// (an `int8` sample becomes an `f64`) plus 1 MiB of slack; for formats that compress,
+/// deflate's largest ratio (1032) on top.
+fn allowed(format: Format, name: &str, len: usize) -> usize {
+    let compressed = matches!(format, Format::Npz | Format::Parquet)
+        || (format == Format::Mat && (name.contains("compressed") || name.contains("v73")));
+    let k = if compressed { 1032 * 8 } else { 8 };
+    k * len + (1 << 20)
+}
+
+fn fixtures() -> Vec<(PathBuf, Format, Vec<u8>)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures");
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if let Ok(f) = Format::from_path(&p) {
+            if f != Format::Csv {
+                out.push((p.clone(), f, std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    assert!(out.len() >= 20, "fixtures found: {}", out.len());
+    out
+}
+
+/// Reads, and checks that an error names the file and that the read was quick; true when
+/// the file was refused.
+fn read(format: Format, name: &str, bytes: &[u8]) -> bool {
+    let t0 = Instant::now();
+    PEAK.with(|p| p.set(0));
+    let r = read_bytes(format, name, bytes);
+    let peak = PEAK.with(|p| p.get());
+    assert!(
+        t0.elapsed() < Duration::from_secs(5),
+        "{name}: {:?}",
+        t0.elapsed()
+    );
+    let limit = allowed(format, name, bytes.len());
+    assert!(
+        peak <= limit,
+        "{name} ({} bytes): allocated {peak} bytes at once, allowed {limit}",
+        bytes.len()
+    );
+    match r {
+        Ok(_) => false,
+        Err(e) => {
+            assert!(e.to_string().starts_with(name), "{e}");
+            true
+        }
+    }
+}
+
+/// The offsets to cut at: every byte of the first 600, then about 400 more spread out.
+fn cuts(len: usize) -> impl Iterator<Item = usize> {
+    let step = (len / 400).max(1);
+    (0..len.min(600)).chain((600..len).step_by(step))
+}
+
+#[test]
+fn truncated_files_are_refused_without_panic() {
+    for (path, format, bytes) in fixtures() {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let mut refused = 0;
+        let mut n = 0;
+        for cut in cuts(bytes.len()) {
+            n += 1;
+            if read(format, &name, &bytes[..cut]) {
+                refused += 1;
+            }
+        }
+        // Text formats may still parse a prefix, but most cuts must be noticed.
+        assert!(
+            refused * 2 > n,
+            "{name}: only {refused} of {n} truncations refused"
+        );
+    }
+}
+
+#[test]
+fn flipped_bytes_never_panic() {
+    for (path, format, bytes) in fixtures() {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let mut b = bytes.clone();
+        let step = (bytes.len() / 300).max(1);
+        for i in (0..bytes.len()).step_by(step) {
+            for mask in [0x01u8, 0x80, 0xff] {
+                b[i] ^= mask;
+                let _ = read(format, &name, &b);
+                b[i] ^= mask;
+            }
+        }
+    }
+}
+
+#[test]
+fn huge_length_fields_never_allocate() {
+    // Every aligned 4- and 8-byte window set to large values: a length or dimension field
+    // claiming gigabytes must be refused before any allocation of that size (a failed
+    // allocation would abort this test).
+    for (path, format, bytes) in fixtures() {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let mut b = bytes.clone();
+        let step = (bytes.len() / 200).max(1) & !3;
+        for i in (0..bytes.len().saturating_sub(8)).step_by(step.max(4)) {
+            for v in [0x7fff_ffffu32, 0xffff_fff0, 0x4000_0000] {
+                let saved: [u8; 8] = b[i..i + 8].try_into().unwrap();
+                b[i..i + 4].copy_from_slice(&v.to_le_bytes());
+                let _ = read(format, &name, &b);
+                b[i..i + 4].copy_from_slice(&v.to_be_bytes());
+                let _ = read(format, &name, &b);
+                b[i..i + 8].copy_from_slice(&(u64::from(v) << 20).to_le_bytes());
+                let _ = read(format, &name, &b);
+                b[i..i + 8].copy_from_slice(&saved);
+            }
+        }
+    }
+}
