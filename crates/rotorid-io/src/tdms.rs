@@ -412,7 +412,7 @@ fn raw_data(
     if chunk == 0 || region == 0 {
         return Ok(());
     }
-    if region % chunk != 0 {
+    if !region.is_multiple_of(chunk) {
         return Err(c.invalid(
             "TDMS raw data size",
             format!("{region} bytes"),

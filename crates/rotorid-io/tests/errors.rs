@@ -24,7 +24,7 @@ fn patch(bytes: &mut [u8], find: &[u8], at: usize, with: u8) -> usize {
 
 fn npy(header: &str, data: &[u8]) -> Vec<u8> {
     let mut h = header.to_string();
-    while (10 + h.len() + 1) % 64 != 0 {
+    while !(10 + h.len() + 1).is_multiple_of(64) {
         h.push(' ');
     }
     h.push('\n');

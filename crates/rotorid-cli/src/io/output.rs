@@ -423,7 +423,7 @@ mod tests {
         }
         o.write_all(b"partial").unwrap();
         let len = std::fs::metadata(&target).unwrap().len();
-        assert!(len > 0 && len % row.len() as u64 == 0, "{len}");
+        assert!(len > 0 && len.is_multiple_of(row.len() as u64), "{len}");
         drop(o);
     }
 }

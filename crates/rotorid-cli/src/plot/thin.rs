@@ -490,7 +490,7 @@ impl Subsample {
 
     /// The next value `v` at time `t`.
     pub fn push(&mut self, t: f64, v: f64) {
-        if self.count % self.stride == 0 {
+        if self.count.is_multiple_of(self.stride) {
             self.kept.push((t, v));
             if self.kept.len() >= self.cap {
                 let mut i = 0;

@@ -79,7 +79,7 @@ impl PhaseGenerator {
     #[inline]
     pub(crate) fn next(&mut self) -> (f64, f64) {
         self.n += 1;
-        if self.n % RESYNC == 0 {
+        if self.n.is_multiple_of(RESYNC) {
             self.resync();
         } else {
             let (s, c, sd, cd) = (self.s, self.c, self.sd, self.cd);

@@ -58,7 +58,7 @@ impl Rows {
     fn write(&mut self, e: &SampleEstimate) {
         let n = self.seen;
         self.seen += 1;
-        if n % self.every != 0 || self.error.is_some() {
+        if !n.is_multiple_of(self.every) || self.error.is_some() {
             return;
         }
         if self.writer.is_none() {

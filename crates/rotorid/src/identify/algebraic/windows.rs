@@ -105,7 +105,7 @@ impl RestartingIdentifier {
         };
         let i = self.i;
         // window `starting` begins at this sample (when i is a multiple of h)
-        let starting = (i % h == 0).then_some(i / h);
+        let starting = i.is_multiple_of(h).then_some(i / h);
         let reporting = if i < 2 * h { 0 } else { i / h - 1 };
         // the identifier that goes on (not restarted here) takes the sample first, so a
         // sample it refuses leaves both unchanged

@@ -188,7 +188,7 @@ impl ModulatingIdentifier {
             w2 * sn - wd * cs,
             wd * sn + w2 * cs,
         ];
-        if self.n % self.hop == 0 {
+        if self.n.is_multiple_of(self.hop) {
             self.open.push_back(OpenWindow {
                 start: self.n,
                 sums: vec![[0.0; NSUM]; self.tf.functions()],
