@@ -49,7 +49,7 @@ pub const MIN_SAMPLES_PER_REV: f64 = 8.0;
 /// The fewest samples per pulse accepted (time the signal stays beyond the threshold).
 pub const MIN_SAMPLES_PER_PULSE: f64 = 2.0;
 /// A range (max - min) below this many times the noise is "no pulse".
-const NO_PULSE_FACTOR: f64 = 10.0;
+const NO_PULSE_FACTOR: f64 = 20.0;
 
 /// What the keyphasor conditioning found.
 #[derive(Debug, Clone, PartialEq, Serialize)]
