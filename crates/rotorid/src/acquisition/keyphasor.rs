@@ -154,7 +154,8 @@ fn detect(
         });
     let noise = noise_from_differences(kp);
     let range = hi - lo;
-    if !(range > NO_PULSE_FACTOR * noise) || range <= 0.0 {
+    let resolved = range > NO_PULSE_FACTOR * noise && range > 0.0;
+    if !resolved {
         return Err(AcquisitionError::NoPulse {
             which,
             column: cfg.column.clone(),
@@ -256,10 +257,11 @@ fn reference_interval(iv: &[f64], k: usize) -> f64 {
 }
 
 /// Remove spurious events and count revolutions across missed ones.
-fn count_revolutions(
-    mut times: Vec<f64>,
-    which: Which,
-) -> Result<(Vec<Event>, Vec<f64>, Vec<f64>), AcquisitionError> {
+/// Events with their revolution counts, times \[s\] after which pulses were missed, and
+/// times of the spurious pulses removed.
+type Counted = (Vec<Event>, Vec<f64>, Vec<f64>);
+
+fn count_revolutions(mut times: Vec<f64>, which: Which) -> Result<Counted, AcquisitionError> {
     let mut spurious = Vec::new();
     // Spurious pulses: an interval much shorter than its neighbours whose sum with the next
     // (or previous) one is a revolution.
@@ -441,7 +443,7 @@ pub fn shaft_angle(
         })
         .collect();
     for nd in &nodes {
-        if !(nd.omega > 0.0) {
+        if nd.omega.is_nan() || nd.omega <= 0.0 {
             return Err(AcquisitionError::SpeedNotPositive {
                 which,
                 t: nd.t,
@@ -503,7 +505,11 @@ pub fn shaft_angle(
         omega.push(v);
         omega_dot.push(a);
     }
-    if let Some((i, &v)) = omega.iter().enumerate().find(|(_, &v)| !(v > 0.0)) {
+    if let Some((i, &v)) = omega
+        .iter()
+        .enumerate()
+        .find(|(_, &v)| v.is_nan() || v <= 0.0)
+    {
         return Err(AcquisitionError::SpeedNotPositive {
             which,
             t: t[i],

@@ -563,7 +563,7 @@ pub fn time_of(
         TimeBase::Column(c) => {
             let t = column(raw, c, "time", which, Some(n), None)?;
             for i in 1..t.len() {
-                if !(t[i] > t[i - 1]) {
+                if t[i].partial_cmp(&t[i - 1]) != Some(std::cmp::Ordering::Greater) {
                     return Err(AcquisitionError::TimeNotIncreasing {
                         which,
                         index: i,
@@ -698,18 +698,18 @@ pub fn condition(
     for k in 0..2 {
         let s = acq.probes[k].sensitivity;
         dc[k] = mean(v[k], range.clone());
-        for i in 0..n {
-            let mut di = (v[k][i] - dc[k]) / s;
+        for (vi, &phi) in v[k].iter().zip(&sa.phi) {
+            let mut di = (vi - dc[k]) / s;
             if let Some(sr) = &slow {
-                di -= sr.runout[k].eval(sa.phi[i]);
+                di -= sr.runout[k].eval(phi);
             }
             d[k].push(di);
         }
     }
     let mut x = Vec::with_capacity(n);
     let mut z = Vec::with_capacity(n);
-    for i in 0..n {
-        let q = inv * nalgebra::Vector2::new(d[0][i], d[1][i]);
+    for (d0, d1) in d[0].iter().zip(&d[1]) {
+        let q = inv * nalgebra::Vector2::new(*d0, *d1);
         x.push(q[0]);
         z.push(q[1]);
     }

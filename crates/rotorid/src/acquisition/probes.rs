@@ -45,7 +45,7 @@ pub fn projection(angles: [f64; 2]) -> Matrix2<f64> {
 /// [`MIN_PROBE_SEPARATION_DEG`] apart.
 pub fn inverse_projection(angles: [f64; 2]) -> Result<Matrix2<f64>, AcquisitionError> {
     let sep = separation_deg(angles[0], angles[1]);
-    if !(sep >= MIN_PROBE_SEPARATION_DEG - 1e-9) {
+    if sep.is_nan() || sep < MIN_PROBE_SEPARATION_DEG - 1e-9 {
         return Err(AcquisitionError::ProbesTooClose {
             angle1_deg: angles[0].to_degrees(),
             angle2_deg: angles[1].to_degrees(),

@@ -54,6 +54,9 @@ use crate::acquisition::{
     DEFAULT_RUNOUT_HARMONICS, METRES_PER_MIL,
 };
 
+/// Rows of numbers and the line of their key.
+type Rows = (Vec<Vec<f64>>, Option<usize>);
+
 /// A table in either TOML form.
 #[derive(Clone, Copy)]
 enum Node<'a> {
@@ -281,7 +284,7 @@ impl Parser<'_> {
         k: &str,
         allowed: &str,
         ok: impl Fn(f64) -> bool,
-    ) -> Result<Option<(Vec<Vec<f64>>, Option<usize>)>, ScenarioFileError> {
+    ) -> Result<Option<Rows>, ScenarioFileError> {
         let Some((line, v)) = e.get(k) else {
             return Ok(None);
         };
@@ -581,7 +584,7 @@ impl Parser<'_> {
             s.gap_v = g;
         }
         if let Some(r) = pair("range_v", "finite (V), low then high")? {
-            if !(r[1] > r[0]) {
+            if r[1] <= r[0] {
                 let (l, _) = e.get("range_v").expect("present");
                 return Err(self.range(
                     l,

@@ -194,7 +194,7 @@ fn refine_on_conditioned_raw_data_is_within_twice_the_perfect_channels_quick() {
 }
 
 #[test]
-#[ignore = "long: cargo test --release -p rotorid --test it acquisition_study -- --ignored --nocapture"]
+#[ignore = "long: cargo test -p rotorid --test it acquisition_study -- --ignored --nocapture"]
 fn acquisition_study_over_many_seeds() {
     for ramp in [false, true] {
         let r = study(ramp, 20);
