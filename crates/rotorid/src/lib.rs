@@ -16,6 +16,7 @@
 //! Pure computation: no file I/O (callers read files and hand over their text), no
 //! plotting (those live in the `rotorid` command).
 
+pub mod acquisition;
 pub mod analysis;
 mod expm;
 pub mod identify;

@@ -32,7 +32,7 @@ pub enum ScenarioFileError {
     /// A top-level name that is not one of the four sections.
     #[error(
         "{}: unknown section or key `{name}`; allowed sections: [rotor], [speed], \
-         [sampling], [initial]",
+         [sampling], [initial], [acquisition]",
         At(origin, line)
     )]
     UnknownSection {
@@ -210,6 +210,18 @@ pub enum ScenarioFileError {
         /// The profile's kind.
         kind: SpeedKind,
     },
+    /// A key of `[acquisition]` that must be given.
+    #[error("{}: missing key {key} ({what})", At(origin, line))]
+    MissingKey {
+        /// The file name.
+        origin: String,
+        /// The line of the table that lacks it.
+        line: Option<usize>,
+        /// `table.key` (`acquisition.keyphasor.column`).
+        key: String,
+        /// What it holds, with its unit.
+        what: String,
+    },
     /// A sampling value given neither in `[sampling]` nor on the command line.
     #[error("{origin}: missing key sampling.{key} (s); give it in [sampling] or with {flag}")]
     MissingSamplingKey {
@@ -239,7 +251,8 @@ impl ScenarioFileError {
             | Self::MissingRotorKey { origin, .. }
             | Self::MissingSpeedKind { origin, .. }
             | Self::MissingSpeedKey { origin, .. }
-            | Self::MissingSamplingKey { origin, .. } => origin,
+            | Self::MissingSamplingKey { origin, .. }
+            | Self::MissingKey { origin, .. } => origin,
         }
     }
 
@@ -256,7 +269,8 @@ impl ScenarioFileError {
             | Self::UnknownSpeedKind { line, .. }
             | Self::SpeedKeyNotApplicable { line, .. }
             | Self::MissingSpeedKind { line, .. }
-            | Self::MissingSpeedKey { line, .. } => *line,
+            | Self::MissingSpeedKey { line, .. }
+            | Self::MissingKey { line, .. } => *line,
             Self::MissingSection { .. }
             | Self::MissingRotorKey { .. }
             | Self::MissingSamplingKey { .. } => None,

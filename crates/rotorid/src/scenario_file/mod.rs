@@ -57,6 +57,7 @@
 //! [`BUILTIN_TABLE1`] is the name callers give the built-in [`Scenario::table1`] (paper's
 //! Table 1, 1200 rpm, dt = 0.1 ms, 1 s, at rest): see [`ScenarioSpec::builtin`].
 
+mod acquisition;
 mod error;
 mod parse;
 
@@ -93,6 +94,7 @@ const SPEED_KEYS: [(&str, &str); 5] = [
 const SAMPLING_KEYS: [(&str, &str); 2] = [("dt", "s"), ("duration", "s")];
 const INITIAL_KEYS: [(&str, &str); 4] = [("x", "m"), ("z", "m"), ("vx", "m/s"), ("vz", "m/s")];
 const SECTIONS: [&str; 4] = ["rotor", "speed", "sampling", "initial"];
+// `[acquisition]` is parsed apart (`acquisition.rs`): it has sub-tables and arrays.
 /// What `[rotor]` and `[speed]` hold, for the messages about a missing section.
 const ROTOR_CONTENTS: &str = "a, m_u, d, alpha_deg and, to simulate, m, cx, cz, kx, kz";
 const SPEED_CONTENTS: &str = "kind = \"constant\" with rpm, or kind = \"ramp\" with rpm0 and accel";
@@ -148,6 +150,7 @@ pub struct ScenarioSpec {
     speed: Option<SpeedProfile>,
     sampling: Option<Section>,
     initial: Section,
+    acquisition: Option<crate::acquisition::Acquisition>,
 }
 
 /// Command-line values that take precedence over the scenario file in `simulate`.
@@ -247,7 +250,15 @@ impl ScenarioSpec {
             speed: None,
             sampling: None,
             initial: Section::default(),
+            acquisition: None,
         }
+    }
+
+    /// The `[acquisition]` table (probes, keyphasor, slow roll, raw-simulation settings),
+    /// when the file has one; every key was checked when parsed. Its `slow_roll` path is as
+    /// written, relative to the scenario file.
+    pub fn acquisition(&self) -> Option<&crate::acquisition::Acquisition> {
+        self.acquisition.as_ref()
     }
 
     /// Parse and check the TOML `text`; `origin` (the file name) prefixes every message.

@@ -45,7 +45,7 @@ enum Raw {
 
 impl Parser<'_> {
     /// 1-based line of byte offset `pos`.
-    fn line(&self, pos: usize) -> usize {
+    pub(super) fn line(&self, pos: usize) -> usize {
         let pos = pos.min(self.text.len());
         self.text.as_bytes()[..pos]
             .iter()
@@ -54,7 +54,7 @@ impl Parser<'_> {
             + 1
     }
 
-    fn key_line(&self, key: Option<&Key>) -> Option<usize> {
+    pub(super) fn key_line(&self, key: Option<&Key>) -> Option<usize> {
         key.and_then(Key::span).map(|s| self.line(s.start))
     }
 
@@ -77,7 +77,7 @@ impl Parser<'_> {
 
     /// The source text of `span`, on one line; `{...}` for a table that has none (the
     /// implicit table of a dotted key).
-    fn written(&self, span: Option<Range<usize>>) -> String {
+    pub(super) fn written(&self, span: Option<Range<usize>>) -> String {
         match span.and_then(|s| self.text.get(s)) {
             Some(t) => t.split_whitespace().collect::<Vec<_>>().join(" "),
             None => "{...}".to_owned(),
@@ -97,8 +97,13 @@ impl Parser<'_> {
         let root = doc.as_table();
         // The top level: only the four sections, each a table in any of TOML's forms.
         let mut raw: BTreeMap<&str, (Option<usize>, Vec<Entry<'_>>)> = BTreeMap::new();
+        let mut acquisition = None;
         for (name, item) in root.iter() {
             let line = self.key_line(root.key(name));
+            if name == "acquisition" {
+                acquisition = Some(self.acquisition(item, line)?);
+                continue;
+            }
             let Some(sec) = SECTIONS.iter().find(|s| **s == name) else {
                 return Err(ScenarioFileError::UnknownSection {
                     origin: self.origin(),
@@ -158,6 +163,7 @@ impl Parser<'_> {
             speed,
             sampling,
             initial: initial.unwrap_or_default(),
+            acquisition,
         })
     }
 

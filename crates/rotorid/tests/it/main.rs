@@ -3,6 +3,7 @@
 
 mod identify_common;
 
+mod acquisition;
 mod adequacy;
 mod algebraic_windows;
 mod analysis;
