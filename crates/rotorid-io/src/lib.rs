@@ -9,6 +9,7 @@
 //!
 //! The crate does no identification: it turns bytes into SI samples and back.
 
+pub mod csv;
 pub mod table;
 pub mod units;
 

@@ -34,6 +34,7 @@ fn py_err(e: Error) -> PyErr {
             std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(text),
             _ => PyOSError::new_err(text),
         },
+        Error::Csv(c) if c.io_kind.is_some() => PyOSError::new_err(text),
         _ => PyValueError::new_err(text),
     }
 }

@@ -21,12 +21,13 @@ use std::io::{self, Read, Write};
 
 use csv::ByteRecord;
 
-use super::columns::{
+use rotorid_io::csv::columns::{
     check_length, csv_reader, finite_field, next_record, number_field, optional_field, CsvReader,
     Header,
 };
-use super::csv_error::CsvError;
-use super::number::write_row;
+use rotorid_io::csv::number::write_row;
+use rotorid_io::csv::CsvError;
+
 use super::params::ParameterSet;
 
 /// The header `identify` writes.

@@ -8,13 +8,13 @@
 //!
 //! Limits: a line (header included) holds at most [`MAX_LINE_BYTES`] ([`super::lines`]),
 //! a number field at most [`MAX_FIELD_BYTES`]; messages quote at most a short prefix of a
-//! bad value ([`super::csv_error::quote`]).
+//! bad value ([`super::error::quote`]).
 
 use std::io::Read;
 
 use csv::ByteRecord;
 
-use super::csv_error::{abbreviate, quote, CsvError, WriteFailure};
+use super::error::{abbreviate, quote, CsvError, WriteFailure};
 use super::lines::{LineReader, LineTooLong, MAX_LINE_BYTES};
 
 /// The longest number field accepted, in bytes (the shortest round-trip text of any `f64`
@@ -223,8 +223,8 @@ pub fn next_record<R: Read>(
 }
 
 /// Map a `csv` crate error (I/O, mostly) met at `line` to a [`CsvError`] for `file`. A
-/// line over the cap names the cap; a failed write of the output (flushed before a read,
-/// see [`super::FlushBeforeRead`]) names the output, not the input.
+/// line over the cap names the cap; a failed write of the caller's output (flushed before a
+/// read, carrying a [`WriteFailure`]) names the output, not the input.
 pub fn read_error(file: &str, e: csv::Error, line: u64) -> CsvError {
     match e.kind() {
         csv::ErrorKind::Io(io) => io_error(file, io, line),

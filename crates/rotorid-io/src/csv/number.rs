@@ -36,7 +36,6 @@ pub fn push_f64(out: &mut Vec<u8>, v: f64) {
 }
 
 /// The shortest round-trip text of `v` as a `String` (see the module doc).
-#[cfg(test)]
 pub fn format_f64(v: f64) -> String {
     let mut buf = Vec::with_capacity(24);
     push_f64(&mut buf, v);
@@ -167,8 +166,7 @@ mod tests {
 
     /// Property test over random bit patterns (every sign, exponent and mantissa is
     /// reachable), and over `i * dt` grids as written by `simulate`. A xorshift generator
-    /// with a fixed seed keeps the test deterministic (proptest is not a dependency of
-    /// the CLI crate).
+    /// with a fixed seed keeps the test deterministic.
     #[test]
     fn random_bit_patterns_round_trip() {
         let mut s: u64 = 0x9E37_79B9_7F4A_7C15;
