@@ -21,6 +21,10 @@ pub struct Response {
     pub z: Vec<f64>,
     /// phi, phi_dot, phi_ddot.
     pub speed: Option<[Vec<f64>; 3]>,
+    /// The columns the file gives in other units than SI, each with that unit (`("x",
+    /// "um")`), in the order t, x, z, phi, phi_dot, phi_ddot: their values above are
+    /// converted to SI.
+    pub converted: Vec<(String, String)>,
 }
 
 /// Read the response CSV at `path` (module doc).
@@ -36,6 +40,11 @@ pub fn read(path: &str) -> Result<Response, Error> {
 pub fn parse<R: Read>(file: &str, input: R) -> Result<Response, Error> {
     let mut reader = ResponseReader::new(file, input)?;
     let mut r = Response {
+        converted: reader
+            .conversions()
+            .into_iter()
+            .map(|(name, c)| (name.to_owned(), c.unit.to_owned()))
+            .collect(),
         speed: reader
             .has_phi()
             .then(|| [Vec::new(), Vec::new(), Vec::new()]),
@@ -83,6 +92,28 @@ mod tests {
         .unwrap();
         assert_eq!(r.z[0], -3.3e-300);
         assert_eq!(r.speed.unwrap()[1][0], 125.66370614359172);
+    }
+
+    #[test]
+    fn units_convert_and_are_reported() {
+        let r = parse(
+            "d.csv",
+            "t,x [um],z [m],phi [deg],phi_dot [rpm],phi_ddot\n0,12.5,1,180,60,0\n".as_bytes(),
+        )
+        .unwrap();
+        assert_eq!(r.x, vec![12.5 / 1e6]);
+        assert_eq!(r.z, vec![1.0]);
+        assert_eq!(
+            r.converted,
+            vec![
+                ("x".to_owned(), "um".to_owned()),
+                ("phi".to_owned(), "deg".to_owned()),
+                ("phi_dot".to_owned(), "rpm".to_owned())
+            ]
+        );
+        assert!(err("t,x [furlong],z\n").starts_with(
+            "d.csv line 1, column 2 (x): unknown unit \"furlong\" for a displacement"
+        ));
     }
 
     #[test]

@@ -2,7 +2,8 @@
 //! [--from S --to S]`: draw a CSV written by `rotorid simulate` or `rotorid identify`.
 //!
 //! The kind is chosen from the header (names compared as the readers in [`crate::io`]
-//! compare them: trimmed, lower-case, a unit suffix `[m]` or `(m)` dropped):
+//! compare them: trimmed, lower-case, a unit suffix `[m]` or `(m)` split off; a response's
+//! columns in other units are converted to SI as they are read, with a `note:` line each):
 //!
 //! - an estimates column (`m_x` ... `k_z`, `rcond_x`, `rcond_z`): identify output
 //!   (`t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z`) -> three stacked panels m, c, k against
@@ -251,6 +252,7 @@ struct ResponseData {
 
 fn read_response<R: Read>(name: &str, input: R, window: Window) -> anyhow::Result<ResponseData> {
     let mut r = ResponseReader::new(name, input)?;
+    r.print_conversions();
     let mut d = ResponseData {
         extent: Extent::new(),
         x: ColumnThinner::new(COLUMNS, window),

@@ -86,6 +86,15 @@ impl<R: Read> ResponseReader<R> {
         self.0.has_phi()
     }
 
+    /// Print `note: FILE: x in um, converted to m (x 1e-6)` on stderr for each column the
+    /// reader converts to SI (nothing for a file in SI): the numbers the run works on are
+    /// not the file's, and the user is told so.
+    pub fn print_conversions(&self) {
+        for note in self.0.conversion_notes() {
+            eprintln!("note: {note}");
+        }
+    }
+
     /// The next validated row, or `None` at the end of the input.
     pub fn next_row(&mut self) -> Result<Option<ResponseRow>, CsvError> {
         Ok(self.0.next_row()?.map(|r| ResponseRow {

@@ -2,9 +2,12 @@
 //! suffix), the search for required columns, and the parsing of one numeric field.
 //!
 //! Header names are compared after trimming blanks, dropping a UTF-8 byte-order mark,
-//! dropping one trailing unit suffix in brackets or parentheses (`x [m]`, `phi_dot (rad/s)`)
-//! and lower-casing, so `t,x,z`, `T [s],X [m],Z [m]` and `t (s), x (m), z (m)` all name the
-//! same columns. The unit in a suffix is not checked: values are always read as SI.
+//! splitting off one trailing unit suffix in brackets or parentheses (`x [um]`,
+//! `phi_dot (rpm)`; [`crate::units::split_unit`]) and lower-casing, so `t,x,z`,
+//! `T [s],X [m],Z [m]` and `t (s), x (m), z (m)` all name the same columns. The unit is
+//! kept ([`Header::units`]): a reader converts the columns it uses to SI with
+//! [`crate::units::conversion`] and refuses a unit it does not know for the column's role
+//! (the response reader: [`super::response`]). No suffix means SI.
 //!
 //! Limits: a line (header included) holds at most [`MAX_LINE_BYTES`] ([`super::lines`]),
 //! a number field at most [`MAX_FIELD_BYTES`]; messages quote at most a short prefix of a
@@ -16,6 +19,7 @@ use csv::ByteRecord;
 
 use super::error::{abbreviate, quote, CsvError, WriteFailure};
 use super::lines::{LineReader, LineTooLong, MAX_LINE_BYTES};
+use crate::units::{conversion, split_unit, Conversion, Quantity};
 
 /// The longest number field accepted, in bytes (the shortest round-trip text of any `f64`
 /// has at most 24).
@@ -26,26 +30,24 @@ const HEADER_QUOTE_CHARS: usize = 200;
 
 /// The normalised column name (see the module doc).
 pub fn normalise(raw: &[u8]) -> String {
+    name_and_unit(raw).0
+}
+
+/// The normalised column name and the unit of its suffix, as written (trimmed), if any:
+/// `b" X [um] "` -> `("x", Some("um"))`.
+pub fn name_and_unit(raw: &[u8]) -> (String, Option<String>) {
     let s = String::from_utf8_lossy(raw);
-    let s = s.trim_start_matches('\u{feff}').trim();
-    let s = strip_unit(s, '[', ']').unwrap_or_else(|| strip_unit(s, '(', ')').unwrap_or(s));
-    s.trim().to_lowercase()
+    let (name, unit) = split_unit(s.trim_start_matches('\u{feff}'));
+    (name.to_lowercase(), unit.map(str::to_owned))
 }
 
-fn strip_unit(s: &str, open: char, close: char) -> Option<&str> {
-    if !s.ends_with(close) {
-        return None;
-    }
-    let i = s.rfind(open)?;
-    let head = s[..i].trim_end();
-    (!head.is_empty()).then_some(head)
-}
-
-/// The header of a CSV file: normalised names and the line it is on.
+/// The header of a CSV file: normalised names, their units and the line it is on.
 #[derive(Debug, Clone)]
 pub struct Header {
     /// Normalised names, in file order.
     pub names: Vec<String>,
+    /// The unit suffix of each column as written (`um`, `rpm`), `None` without one.
+    pub units: Vec<Option<String>>,
     /// 1-based line of the header.
     pub line: u64,
 }
@@ -53,10 +55,26 @@ pub struct Header {
 impl Header {
     /// Read from the header record `rec` found at `line`.
     pub fn new(rec: &ByteRecord, line: u64) -> Self {
-        Self {
-            names: rec.iter().map(normalise).collect(),
-            line,
-        }
+        let (names, units) = rec.iter().map(name_and_unit).unzip();
+        Self { names, units, line }
+    }
+
+    /// How column `col`, holding `quantity` for the role `name`, becomes SI: from its unit
+    /// suffix (none: SI). A unit that is unknown or of another quantity is an error naming
+    /// the header line, the column and the units accepted.
+    pub fn conversion(
+        &self,
+        file: &str,
+        col: usize,
+        name: &str,
+        quantity: Quantity,
+    ) -> Result<Conversion, CsvError> {
+        let unit = self.units.get(col).and_then(Option::as_deref);
+        conversion(quantity, unit).map_err(|e| {
+            let mut err = CsvError::field(file, self.line, col, name, e.to_string());
+            err.unit = Some(e);
+            err
+        })
     }
 
     /// Position of column `name`, or `None`. A name that appears twice is an error
@@ -292,7 +310,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn names_drop_units_case_and_blanks() {
+    fn names_split_units_drop_case_and_blanks() {
+        assert_eq!(
+            name_and_unit(" X [um] ".as_bytes()),
+            ("x".to_owned(), Some("um".to_owned()))
+        );
+        assert_eq!(
+            name_and_unit("\u{feff}t (ms)".as_bytes()),
+            ("t".to_owned(), Some("ms".to_owned()))
+        );
+        assert_eq!(name_and_unit(b"Phi_Dot"), ("phi_dot".to_owned(), None));
         assert_eq!(normalise(b" x [m] "), "x");
         assert_eq!(normalise(b"phi_dot (rad/s)"), "phi_dot");
         assert_eq!(normalise("\u{feff}T".as_bytes()), "t");
