@@ -170,10 +170,9 @@ fn read_head<R: Read>(name: &str, input: R) -> anyhow::Result<(Vec<u8>, LineRead
 /// The kind of CSV whose first line(s) `head` holds, from its header line (module doc).
 pub fn detect(name: &str, head: &[u8]) -> anyhow::Result<CsvKind> {
     let mut csv = csv_reader(head);
-    let mut rec = csv::ByteRecord::new();
-    if next_record(name, &mut csv, &mut rec)?.is_none() {
+    let Some(rec) = next_record(name, &mut csv)? else {
         bail!("{name}: the file is empty: expected a CSV header (t,x,z,... or t,m_x,...,rcond_z)");
-    }
+    };
     let names: Vec<String> = rec.iter().map(normalise).collect();
     let has = |n: &str| names.iter().any(|h| h == n);
     if ESTIMATES_HEADER[1..].iter().any(|n| has(n)) {

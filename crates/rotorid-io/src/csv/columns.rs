@@ -15,10 +15,10 @@
 
 use std::io::Read;
 
-use csv::ByteRecord;
-
 use super::error::{abbreviate, quote, CsvError, WriteFailure};
-use super::lines::{LineReader, LineTooLong, MAX_LINE_BYTES};
+use super::lines::{LineTooLong, MAX_LINE_BYTES};
+use super::number::parse_f64;
+use super::records::{Record, RecordReader};
 use crate::units::{conversion, split_unit, Conversion, Quantity};
 
 /// The longest number field accepted, in bytes (the shortest round-trip text of any `f64`
@@ -54,7 +54,7 @@ pub struct Header {
 
 impl Header {
     /// Read from the header record `rec` found at `line`.
-    pub fn new(rec: &ByteRecord, line: u64) -> Self {
+    pub fn new(rec: &Record<'_>, line: u64) -> Self {
         let (names, units) = rec.iter().map(name_and_unit).unzip();
         Self { names, units, line }
     }
@@ -131,7 +131,7 @@ impl Header {
 /// name for the message, `line` the record's line.
 pub fn finite_field(
     file: &str,
-    rec: &ByteRecord,
+    rec: &Record<'_>,
     line: u64,
     col: usize,
     name: &str,
@@ -153,7 +153,7 @@ pub fn finite_field(
 /// Parse field `col` of `rec` as an `f64` (NaN and infinity accepted).
 pub fn number_field(
     file: &str,
-    rec: &ByteRecord,
+    rec: &Record<'_>,
     line: u64,
     col: usize,
     name: &str,
@@ -172,31 +172,28 @@ pub fn number_field(
             ),
         ));
     }
-    std::str::from_utf8(raw)
-        .ok()
-        .and_then(|s| s.trim().parse::<f64>().ok())
-        .ok_or_else(|| {
-            let text = String::from_utf8_lossy(raw);
-            let what = if text.trim().is_empty() {
-                "is empty".to_owned()
-            } else {
-                format!("{} is not a number", quote(text.trim().as_bytes()))
-            };
-            CsvError::field(
-                file,
-                line,
-                col,
-                name,
-                format!("{name} {what}: expected a number"),
-            )
-        })
+    parse_f64(raw).ok_or_else(|| {
+        let text = String::from_utf8_lossy(raw);
+        let what = if text.trim().is_empty() {
+            "is empty".to_owned()
+        } else {
+            format!("{} is not a number", quote(text.trim().as_bytes()))
+        };
+        CsvError::field(
+            file,
+            line,
+            col,
+            name,
+            format!("{name} {what}: expected a number"),
+        )
+    })
 }
 
 /// An optional number: an empty field or NaN is `None` (the estimates file writes missing
 /// estimates as empty fields).
 pub fn optional_field(
     file: &str,
-    rec: &ByteRecord,
+    rec: &Record<'_>,
     line: u64,
     col: usize,
     name: &str,
@@ -209,48 +206,31 @@ pub fn optional_field(
     Ok((!v.is_nan()).then_some(v))
 }
 
-/// The CSV reader of every file here: lines numbered and capped by a [`LineReader`].
-pub type CsvReader<R> = csv::Reader<LineReader<R>>;
+/// The CSV reader of every file here: records split in place, lines numbered and capped
+/// ([`super::records`]).
+pub type CsvReader<R> = RecordReader<R>;
 
 /// A CSV reader configured as every reader here needs it: no header handling (we read the
 /// header ourselves to know its line), rows of any length (checked by the caller, with a
 /// better message), blanks trimmed around fields, lines numbered and capped
 /// ([`super::lines`]).
 pub fn csv_reader<R: Read>(input: R) -> CsvReader<R> {
-    csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .trim(csv::Trim::All)
-        .buffer_capacity(64 * 1024)
-        .from_reader(LineReader::new(input))
+    RecordReader::new(input)
 }
 
-/// Read the next record of `csv` into `rec`: the line it begins on (1-based, LF, CRLF and
-/// CR line ends alike), or `None` at the end of the input.
-pub fn next_record<R: Read>(
+/// The next record of `csv` (its line: [`Record::line`], 1-based, LF, CRLF and CR line
+/// ends alike), or `None` at the end of the input. A line over the cap names the cap; a
+/// failed write of the caller's output (flushed before a read, carrying a
+/// [`WriteFailure`]) names the output, not the input.
+pub fn next_record<'a, R: Read>(
     file: &str,
-    csv: &mut CsvReader<R>,
-    rec: &mut ByteRecord,
-) -> Result<Option<u64>, CsvError> {
-    csv.get_mut().mark();
-    match csv.read_byte_record(rec) {
-        Ok(true) => Ok(Some(csv.get_ref().record_line())),
-        Ok(false) => Ok(None),
-        Err(e) => Err(read_error(file, e, csv.get_ref().line())),
-    }
+    csv: &'a mut CsvReader<R>,
+) -> Result<Option<Record<'a>>, CsvError> {
+    csv.next_record()
+        .map_err(|e| io_error(file, &e.error, e.line))
 }
 
-/// Map a `csv` crate error (I/O, mostly) met at `line` to a [`CsvError`] for `file`. A
-/// line over the cap names the cap; a failed write of the caller's output (flushed before a
-/// read, carrying a [`WriteFailure`]) names the output, not the input.
-pub fn read_error(file: &str, e: csv::Error, line: u64) -> CsvError {
-    match e.kind() {
-        csv::ErrorKind::Io(io) => io_error(file, io, line),
-        _ => CsvError::line(file, line, format!("cannot read: {e}")),
-    }
-}
-
-/// [`read_error`] for an I/O error met at `line` of `file`.
+/// The [`CsvError`] of an I/O error met at `line` of `file` (see [`next_record`]).
 pub fn io_error(file: &str, io: &std::io::Error, line: u64) -> CsvError {
     let inner = io.get_ref();
     if let Some(t) = inner.and_then(|i| i.downcast_ref::<LineTooLong>()) {
@@ -285,7 +265,7 @@ pub fn io_error(file: &str, io: &std::io::Error, line: u64) -> CsvError {
 /// Check that a record has as many fields as the header.
 pub fn check_length(
     file: &str,
-    rec: &ByteRecord,
+    rec: &Record<'_>,
     line: u64,
     header: &Header,
 ) -> Result<(), CsvError> {
@@ -309,6 +289,11 @@ pub fn check_length(
 mod tests {
     use super::*;
 
+    /// A reader of the one line `fields` joined by commas.
+    fn line_of(fields: &[&str]) -> RecordReader<std::io::Cursor<Vec<u8>>> {
+        RecordReader::new(std::io::Cursor::new(fields.join(",").into_bytes()))
+    }
+
     #[test]
     fn names_split_units_drop_case_and_blanks() {
         assert_eq!(
@@ -330,7 +315,8 @@ mod tests {
     #[test]
     fn long_fields_and_headers_are_quoted_short() {
         let long = "9".repeat(2000);
-        let rec = ByteRecord::from(vec![long.as_str(), "x".repeat(500).as_str()]);
+        let mut r = line_of(&[long.as_str(), "x".repeat(500).as_str()]);
+        let rec = r.next_record().unwrap().unwrap();
         let e = finite_field("f", &rec, 2, 0, "t").unwrap_err().to_string();
         assert!(
             e.starts_with("f line 2, column 1 (t): t \"9999")
@@ -344,7 +330,9 @@ mod tests {
         );
         assert!(e.len() < 200, "{e}");
         let names = vec!["q".repeat(10_000); 3];
-        let h = Header::new(&ByteRecord::from(names), 1);
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let mut r = line_of(&names);
+        let h = Header::new(&r.next_record().unwrap().unwrap(), 1);
         let e = h.require("f", &["t", "x", "z"]).unwrap_err().to_string();
         assert!(e.len() < 400 && e.ends_with("(30002 bytes in all))"), "{e}");
     }
@@ -358,10 +346,9 @@ mod tests {
             "h\n1\n\n2",
         ] {
             let mut csv = csv_reader(text.as_bytes());
-            let mut rec = ByteRecord::new();
             let mut lines = Vec::new();
-            while let Some(l) = next_record("f", &mut csv, &mut rec).unwrap() {
-                lines.push((l, rec.get(0).unwrap().to_vec()));
+            while let Some(rec) = next_record("f", &mut csv).unwrap() {
+                lines.push((rec.line(), rec.get(0).unwrap().to_vec()));
             }
             assert_eq!(
                 lines,
@@ -373,7 +360,8 @@ mod tests {
 
     #[test]
     fn fields_parse_or_say_why_not() {
-        let rec = ByteRecord::from(vec!["1.5", "abc", "", "NaN", "inf"]);
+        let mut r = line_of(&["1.5", "abc", "", "NaN", "inf"]);
+        let rec = r.next_record().unwrap().unwrap();
         assert_eq!(finite_field("f", &rec, 2, 0, "t").unwrap(), 1.5);
         let e = finite_field("f", &rec, 2, 1, "x").unwrap_err();
         assert_eq!(

@@ -14,6 +14,7 @@ pub mod columns;
 pub mod error;
 pub mod lines;
 pub mod number;
+pub mod records;
 pub mod response;
 
 pub use error::{CsvError, WriteFailure};

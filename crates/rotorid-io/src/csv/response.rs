@@ -32,8 +32,6 @@
 
 use std::io::Read;
 
-use csv::ByteRecord;
-
 use super::columns::{check_length, csv_reader, finite_field, next_record, CsvReader, Header};
 use super::error::CsvError;
 use super::number::{format_f64, readable};
@@ -88,21 +86,20 @@ pub struct ResponseReader<R: Read> {
     phi: Option<[usize; 3]>,
     /// The conversion to SI of t, x, z, phi, phi_dot, phi_ddot.
     conv: [Conversion; 6],
-    rec: ByteRecord,
 }
 
 impl<R: Read> ResponseReader<R> {
     /// Read and check the header of `input`; `file` names it in messages.
     pub fn new(file: &str, input: R) -> Result<Self, CsvError> {
         let mut csv = csv_reader(input);
-        let mut rec = ByteRecord::new();
-        let Some(line) = next_record(file, &mut csv, &mut rec)? else {
+        let Some(rec) = next_record(file, &mut csv)? else {
             return Err(CsvError::file(
                 file,
                 "the file is empty: expected a header line naming at least t,x,z, then one \
                  row per sample",
             ));
         };
+        let line = rec.line();
         let header = Header::new(&rec, line);
         let txz = header.require(file, &["t", "x", "z"])?;
         let phis = [
@@ -147,7 +144,6 @@ impl<R: Read> ResponseReader<R> {
             txz: [txz[0], txz[1], txz[2]],
             phi,
             conv,
-            rec,
         })
     }
 
@@ -182,14 +178,16 @@ impl<R: Read> ResponseReader<R> {
     /// The next validated row, or `None` at the end of the input.
     pub fn next_row(&mut self) -> Result<Option<ResponseRow>, CsvError> {
         let f = self.file.as_str();
-        let Some(line) = next_record(f, &mut self.csv, &mut self.rec)? else {
+        let Some(rec) = next_record(f, &mut self.csv)? else {
             return Ok(None);
         };
-        check_length(f, &self.rec, line, &self.header)?;
+        let line = rec.line();
+        check_length(f, &rec, line, &self.header)?;
+        let conv = &self.conv;
         let field = |col: usize, role: usize| {
             let name = RESPONSE_HEADER[role];
-            let v = finite_field(f, &self.rec, line, col, name)?;
-            convert(f, line, col, name, &self.conv[role], v)
+            let v = finite_field(f, &rec, line, col, name)?;
+            convert(f, line, col, name, &conv[role], v)
         };
         let [ct, cx, cz] = self.txz;
         let t = field(ct, 0)?;
