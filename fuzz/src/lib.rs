@@ -7,7 +7,9 @@
 
 #![allow(dead_code, unused_imports)]
 
-pub use rotorid_io::csv::{columns, error as csv_error, lines, number, response as response_csv};
+pub use rotorid_io::csv::{
+    columns, error as csv_error, lines, number, records, response as response_csv,
+};
 
 #[path = "../../crates/rotorid-cli/src/io/estimates_csv.rs"]
 pub mod estimates_csv;

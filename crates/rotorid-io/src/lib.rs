@@ -8,6 +8,11 @@
 //! it does not know, naming the channel.
 //!
 //! The crate does no identification: it turns bytes into SI samples and back.
+//!
+//! [`csv`] reads the response CSV that `rotorid simulate` writes (and any CSV with the
+//! same columns, units in its header converted), streaming, at close to the speed the file
+//! can be read: records split in place, numbers parsed bit for bit as `str::parse` parses
+//! them and written in shortest round-trip form.
 
 pub mod csv;
 pub mod table;

@@ -6,7 +6,7 @@
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
-use crate::common::{identify_with_summary, param, rotorid, simulate};
+use crate::common::{identify_with_summary, rotorid, simulate};
 
 /// table1 at 10 kHz for 0.3 s, with phi columns, in SI.
 fn si_csv() -> &'static str {

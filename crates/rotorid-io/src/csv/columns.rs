@@ -72,7 +72,7 @@ impl Header {
         let unit = self.units.get(col).and_then(Option::as_deref);
         conversion(quantity, unit).map_err(|e| {
             let mut err = CsvError::field(file, self.line, col, name, e.to_string());
-            err.unit = Some(e);
+            err.unit = Some(Box::new(e));
             err
         })
     }

@@ -55,7 +55,7 @@ pub struct CsvError {
     pub io_kind: Option<std::io::ErrorKind>,
     /// Set when the failure is a unit in the header that the column's role cannot take (its
     /// text is in the message too).
-    pub unit: Option<UnitError>,
+    pub unit: Option<Box<UnitError>>,
 }
 
 impl CsvError {

@@ -440,6 +440,8 @@ mod tests {
     }
 
     #[test]
+    // the literals are exact binary values: their last digit is the point
+    #[allow(clippy::excessive_precision)]
     fn halfway_digits_round_up_as_display_does() {
         // exactly halfway between two 17-digit candidates: ryu alone says ...812
         for (v, text) in [

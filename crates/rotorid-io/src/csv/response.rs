@@ -381,7 +381,7 @@ mod tests {
         .err()
         .unwrap();
         assert!(matches!(
-            e.unit,
+            e.unit.as_deref(),
             Some(crate::UnitError::WrongQuantity {
                 found: Quantity::Angle,
                 expected: Quantity::AngularSpeed,
