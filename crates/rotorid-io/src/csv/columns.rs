@@ -15,11 +15,11 @@
 
 use std::io::Read;
 
-use super::error::{abbreviate, quote, CsvError, WriteFailure};
+use super::error::{abbreviate, quote, CsvError, WriteFailure, QUOTE_CHARS};
 use super::lines::{LineTooLong, MAX_LINE_BYTES};
 use super::number::parse_f64;
 use super::records::{Record, RecordReader};
-use crate::units::{conversion, split_unit, Conversion, Quantity};
+use crate::units::{conversion, split_unit, Conversion, Quantity, UnitError};
 
 /// The longest number field accepted, in bytes (the shortest round-trip text of any `f64`
 /// has at most 24).
@@ -70,7 +70,10 @@ impl Header {
         quantity: Quantity,
     ) -> Result<Conversion, CsvError> {
         let unit = self.units.get(col).and_then(Option::as_deref);
-        conversion(quantity, unit).map_err(|e| {
+        conversion(quantity, unit).map_err(|mut e| {
+            // the unit as written may be anything: quote a short prefix of it
+            let (UnitError::Unknown { unit, .. } | UnitError::WrongQuantity { unit, .. }) = &mut e;
+            *unit = abbreviate(unit, QUOTE_CHARS);
             let mut err = CsvError::field(file, self.line, col, name, e.to_string());
             err.unit = Some(Box::new(e));
             err
@@ -335,6 +338,26 @@ mod tests {
         let h = Header::new(&r.next_record().unwrap().unwrap(), 1);
         let e = h.require("f", &["t", "x", "z"]).unwrap_err().to_string();
         assert!(e.len() < 400 && e.ends_with("(30002 bytes in all))"), "{e}");
+    }
+
+    #[test]
+    fn a_long_unit_is_quoted_short() {
+        let header = format!("x [{}]", "\u{7}".repeat(10_000));
+        let mut r = line_of(&[header.as_str()]);
+        let h = Header::new(&r.next_record().unwrap().unwrap(), 1);
+        let e = h
+            .conversion("f", 0, "x", Quantity::Displacement)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("f line 1, column 1 (x): unknown unit \"\\u{7}"),
+            "{e}"
+        );
+        assert!(
+            e.contains("... (10000 bytes in all)\" for a displacement"),
+            "{e}"
+        );
+        assert!(e.len() < 400, "{} bytes: {e}", e.len());
     }
 
     #[test]
