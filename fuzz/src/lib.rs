@@ -1,25 +1,20 @@
-//! What the fuzz targets share: the CLI's CSV readers, compiled from their sources (the
-//! CLI is a binary crate), and a decoder of fuzz input into f64 values.
+//! What the fuzz targets share: the CSV readers (the response reader and its pieces are
+//! `rotorid-io`'s; the estimates reader is compiled from the CLI's source, the CLI being a
+//! binary crate), and a decoder of fuzz input into f64 values.
 //!
-//! The reader modules are included as they are in `crates/rotorid-cli/src/io/`, at this
+//! The CLI modules are included as they are in `crates/rotorid-cli/src/io/`, at this
 //! crate's root, so their `super::` paths resolve here.
 
 #![allow(dead_code, unused_imports)]
 
-#[path = "../../crates/rotorid-cli/src/io/columns.rs"]
-pub mod columns;
-#[path = "../../crates/rotorid-cli/src/io/csv_error.rs"]
-pub mod csv_error;
+pub use rotorid_io::csv::{
+    columns, error as csv_error, lines, number, records, response as response_csv,
+};
+
 #[path = "../../crates/rotorid-cli/src/io/estimates_csv.rs"]
 pub mod estimates_csv;
-#[path = "../../crates/rotorid-cli/src/io/lines.rs"]
-pub mod lines;
-#[path = "../../crates/rotorid-cli/src/io/number.rs"]
-pub mod number;
 #[path = "../../crates/rotorid-cli/src/io/params.rs"]
 pub mod params;
-#[path = "../../crates/rotorid-cli/src/io/response_csv.rs"]
-pub mod response_csv;
 
 /// Reads fuzz input as a sequence of values, never running dry (zeros after the end).
 pub struct Values<'a> {

@@ -21,12 +21,18 @@
 //! all ([`ReadError::InexactInteger`]).
 //!
 //! The crate does no identification: it turns bytes into SI samples and back.
+//!
+//! [`csv`] reads the response CSV that `rotorid simulate` writes (and any CSV with the
+//! same columns, units in its header converted), streaming, at close to the speed the file
+//! can be read: records split in place, numbers parsed bit for bit as `str::parse` parses
+//! them and written in shortest round-trip form.
 
 // ReadError carries the file, channel, offset, found and allowed values inline so callers can
 // match on them; it is returned once per failed read, so its size costs nothing measurable.
 #![allow(clippy::result_large_err)]
 
 mod cursor;
+pub mod csv;
 pub mod error;
 pub mod format;
 pub mod mat;

@@ -1,7 +1,8 @@
 //! The one error of the package's core: the library's own errors (each already names the
 //! field, the value and the allowed range, or the sample index and column), a keyword
 //! argument or column the caller got wrong, or a file that cannot be read. The extension
-//! module raises `OSError` for [`Error::Io`] and `ValueError` for every other variant.
+//! module raises `OSError` for [`Error::Io`] (and a CSV read that failed) and `ValueError`
+//! for every other variant.
 
 use rotorid::pipeline::PipelineError;
 use rotorid::scenario_file::ScenarioFileError;
@@ -23,6 +24,10 @@ pub enum Error {
     /// names it and what is allowed.
     #[error("{0}")]
     Invalid(String),
+    /// A CSV file whose content cannot be used, or whose reading failed: the message names
+    /// the file, the line and the column (`io_kind` is set for a failed read).
+    #[error(transparent)]
+    Csv(#[from] rotorid_io::csv::CsvError),
     /// A file that cannot be read.
     #[error("cannot read {path}: {source}")]
     Io {

@@ -34,6 +34,7 @@ fn py_err(e: Error) -> PyErr {
             std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(text),
             _ => PyOSError::new_err(text),
         },
+        Error::Csv(c) if c.io_kind.is_some() => PyOSError::new_err(text),
         _ => PyValueError::new_err(text),
     }
 }
@@ -324,9 +325,14 @@ fn simulate<'py>(
     Ok(d)
 }
 
-/// Read a response CSV: a dict of arrays t, x, z [, phi, phi_dot, phi_ddot].
+/// Read a response CSV: a dict of arrays t, x, z [, phi, phi_dot, phi_ddot] in SI, and a
+/// dict of the columns the file gave in other units (name -> unit as given, e.g.
+/// `{"x": "um"}`), whose values were converted.
 #[pyfunction]
-fn read(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyDict>> {
+fn read(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+) -> PyResult<(Bound<'_, PyDict>, Bound<'_, PyDict>)> {
     let path = path.to_string_lossy().into_owned();
     let r = py.detach(|| crate::response::read(&path)).map_err(py_err)?;
     let d = PyDict::new(py);
@@ -338,7 +344,11 @@ fn read(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyDict>>
             d.set_item(name, PyArray1::from_vec(py, c))?;
         }
     }
-    Ok(d)
+    let units = PyDict::new(py);
+    for (name, unit) in r.converted {
+        units.set_item(name, unit)?;
+    }
+    Ok((d, units))
 }
 
 /// The options of a call.

@@ -154,3 +154,20 @@ def test_read_takes_units_and_any_order(tmp_path):
     df = rotorid.read(f)
     assert list(df.columns) == ["t", "x", "z"]
     assert df.to_dict("list") == {"t": [0.0, 0.5], "x": [1.0, 3.0], "z": [2.0, 4.0]}
+    assert df.attrs["units"] == {}
+
+
+def test_read_converts_units_to_si_and_says_which(tmp_path):
+    si = tmp_path / "si.csv"
+    si.write_text("t,x,z,phi,phi_dot,phi_ddot\n0,1.25e-05,-3e-06,3.141592653589793,125.66370614359172,0\n")
+    other = tmp_path / "units.csv"
+    other.write_text("t (ms),x [um],z [µm],phi [deg],phi_dot [rpm],phi_ddot [rpm/s]\n0,12.5,-3,180,1200,0\n")
+    a, b = rotorid.read(si), rotorid.read(other)
+    assert b.attrs["units"] == {"t": "ms", "x": "um", "z": "um", "phi": "deg", "phi_dot": "rpm",
+                                "phi_ddot": "rpm/s"}
+    for col in a.columns:
+        assert b[col][0] == pytest.approx(a[col][0], rel=1e-15, abs=0), col
+    with pytest.raises(ValueError, match=r'units\.csv line 1, column 2 \(x\): unknown unit "furlong" '
+                                         r"for a displacement: use one of m, mm, um"):
+        other.write_text("t,x [furlong],z\n0,0,0\n")
+        rotorid.read(other)

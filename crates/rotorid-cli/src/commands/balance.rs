@@ -323,6 +323,7 @@ fn run_vectors(
 ) -> anyhow::Result<(RunVectors, f64)> {
     let (name, input) = open_input(file)?;
     let mut r = ResponseReader::new(&name, input)?;
+    r.print_conversions();
     if !r.has_phi() && speed.is_none() {
         bail!(
             "{name} has no phi, phi_dot, phi_ddot columns: give --scenario with a [speed] section \

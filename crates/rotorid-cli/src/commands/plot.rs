@@ -2,7 +2,8 @@
 //! [--from S --to S]`: draw a CSV written by `rotorid simulate` or `rotorid identify`.
 //!
 //! The kind is chosen from the header (names compared as the readers in [`crate::io`]
-//! compare them: trimmed, lower-case, a unit suffix `[m]` or `(m)` dropped):
+//! compare them: trimmed, lower-case, a unit suffix `[m]` or `(m)` split off; a response's
+//! columns in other units are converted to SI as they are read, with a `note:` line each):
 //!
 //! - an estimates column (`m_x` ... `k_z`, `rcond_x`, `rcond_z`): identify output
 //!   (`t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z`) -> three stacked panels m, c, k against
@@ -169,10 +170,9 @@ fn read_head<R: Read>(name: &str, input: R) -> anyhow::Result<(Vec<u8>, LineRead
 /// The kind of CSV whose first line(s) `head` holds, from its header line (module doc).
 pub fn detect(name: &str, head: &[u8]) -> anyhow::Result<CsvKind> {
     let mut csv = csv_reader(head);
-    let mut rec = csv::ByteRecord::new();
-    if next_record(name, &mut csv, &mut rec)?.is_none() {
+    let Some(rec) = next_record(name, &mut csv)? else {
         bail!("{name}: the file is empty: expected a CSV header (t,x,z,... or t,m_x,...,rcond_z)");
-    }
+    };
     let names: Vec<String> = rec.iter().map(normalise).collect();
     let has = |n: &str| names.iter().any(|h| h == n);
     if ESTIMATES_HEADER[1..].iter().any(|n| has(n)) {
@@ -251,6 +251,7 @@ struct ResponseData {
 
 fn read_response<R: Read>(name: &str, input: R, window: Window) -> anyhow::Result<ResponseData> {
     let mut r = ResponseReader::new(name, input)?;
+    r.print_conversions();
     let mut d = ResponseData {
         extent: Extent::new(),
         x: ColumnThinner::new(COLUMNS, window),

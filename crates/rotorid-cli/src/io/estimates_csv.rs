@@ -19,14 +19,13 @@
 
 use std::io::{self, Read, Write};
 
-use csv::ByteRecord;
-
-use super::columns::{
+use rotorid_io::csv::columns::{
     check_length, csv_reader, finite_field, next_record, number_field, optional_field, CsvReader,
     Header,
 };
-use super::csv_error::CsvError;
-use super::number::write_row;
+use rotorid_io::csv::number::write_row;
+use rotorid_io::csv::CsvError;
+
 use super::params::ParameterSet;
 
 /// The header `identify` writes.
@@ -102,15 +101,13 @@ pub struct EstimatesReader<R: Read> {
     csv: CsvReader<R>,
     header: Header,
     cols: Vec<usize>,
-    rec: ByteRecord,
 }
 
 impl<R: Read> EstimatesReader<R> {
     /// Read and check the header of `input` (`file` names it in messages).
     pub fn new(file: &str, input: R) -> Result<Self, CsvError> {
         let mut csv = csv_reader(input);
-        let mut rec = ByteRecord::new();
-        let Some(line) = next_record(file, &mut csv, &mut rec)? else {
+        let Some(rec) = next_record(file, &mut csv)? else {
             return Err(CsvError::file(
                 file,
                 format!(
@@ -119,26 +116,26 @@ impl<R: Read> EstimatesReader<R> {
                 ),
             ));
         };
-        let header = Header::new(&rec, line);
+        let header = Header::new(&rec, rec.line());
         let cols = header.require(file, &ESTIMATES_HEADER)?;
         Ok(Self {
             file: file.to_owned(),
             csv,
             header,
             cols,
-            rec,
         })
     }
 
     /// The next row, or `None` at the end.
     pub fn next_row(&mut self) -> Result<Option<EstimateRow>, CsvError> {
         let f = self.file.as_str();
-        let Some(line) = next_record(f, &mut self.csv, &mut self.rec)? else {
+        let Some(rec) = next_record(f, &mut self.csv)? else {
             return Ok(None);
         };
-        check_length(f, &self.rec, line, &self.header)?;
+        let line = rec.line();
+        let rec = &rec;
+        check_length(f, rec, line, &self.header)?;
         let c = &self.cols;
-        let rec = &self.rec;
         let opt = |i: usize| optional_field(f, rec, line, c[i], ESTIMATES_HEADER[i]);
         Ok(Some(EstimateRow {
             t: finite_field(f, rec, line, c[0], "t")?,

@@ -8,26 +8,27 @@
 //! | summary JSON: the serialised `rotorid::pipeline::Identification` (docs/summary.md) | - | identify | scripts |
 //! | summary JSON: identified `rotor`, `covariance` | [`identified`] | identify | analyze, balance |
 //!
-//! Numbers are written in shortest round-trip form ([`number`]): reading a value back gives
-//! the identical `f64`. Readers report errors as `FILE line L, column C (NAME): ...`
+//! The CSV machinery (line numbering and caps, header names and units, number parsing and
+//! formatting, the response reader) is the `rotorid-io` crate's, shared with the Python
+//! package; [`columns`], [`csv_error`], [`lines`] and [`number`] are its modules. Numbers
+//! are written in shortest round-trip form ([`number`]): reading a value back gives the
+//! identical `f64`. Readers report errors as `FILE line L, column C (NAME): ...`
 //! ([`CsvError`]). Outputs go to stdout (`-`) or to a file, atomically or in place
 //! ([`output`]).
 
-pub mod columns;
-pub mod csv_error;
+pub use rotorid_io::csv::{columns, error as csv_error, lines, number};
+
 pub mod estimates_csv;
 pub mod identified;
-pub mod lines;
-pub mod number;
 pub mod output;
 pub mod params;
 pub mod progress;
 pub mod response_csv;
 pub mod scenario;
 
-pub use csv_error::CsvError;
 pub use estimates_csv::{EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES_HEADER};
 pub use output::{check_distinct_files, is_broken_pipe, open_input, FileMode, Output};
 pub use params::ParameterSet;
 pub use response_csv::{ResponseReader, ResponseWriter};
+pub use rotorid_io::csv::CsvError;
 pub use scenario::{LoadScenario, ScenarioSpec, SimulationOverrides, Truth};

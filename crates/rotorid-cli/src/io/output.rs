@@ -37,7 +37,7 @@ use std::path::Path;
 
 use anyhow::Context as _;
 
-pub use super::csv_error::WriteFailure;
+pub use rotorid_io::csv::WriteFailure;
 pub use same_file::check_distinct_files;
 
 /// How a regular file output is written (see the module doc).

@@ -13,3 +13,4 @@ mod refine;
 mod safety;
 mod scenario;
 mod simulate;
+mod units;

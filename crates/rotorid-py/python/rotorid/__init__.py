@@ -101,18 +101,29 @@ def simulate(
 def read(path: str | os.PathLike[str]) -> pd.DataFrame:
     """Read a response CSV as ``rotorid identify`` reads it.
 
-    The header names at least t, x, z (any order, extra columns ignored, a unit suffix
-    such as ``x [m]`` allowed); phi, phi_dot, phi_ddot all three or none. Values in SI.
+    The header names at least t, x, z (any order, extra columns ignored); phi, phi_dot,
+    phi_ddot all three or none. Values are SI unless a column's header gives its unit
+    (``t (ms)``, ``x [um]``, ``phi [deg]``, ``phi_dot [rpm]``, ``phi_ddot [rpm/s]``): those
+    columns are converted to SI, as the CLI converts them. Accepted: t in s, ms, us; x, z
+    in m, mm, um (µm), nm, mil, in; phi in rad, deg, rev; phi_dot in rad/s, rpm, Hz,
+    deg/s; phi_ddot in rad/s^2, rpm/s, Hz/s, deg/s^2.
 
     Returns:
         DataFrame with columns t [s], x, z [m] and, when the file has them, phi [rad],
         phi_dot [rad/s], phi_ddot [rad/s^2], bit for bit the numbers the CLI reads.
+        ``df.attrs["units"]`` maps each column the file gave in another unit to that
+        unit as written (``{"x": "um", "z": "um"}``; empty for a file in SI).
 
     Raises:
         ValueError: naming the file, line and column of a field that is not a finite
-            number, a missing column or a short row. OSError: the file cannot be read.
+            number, a missing column, a short row, or a unit that is unknown or not one
+            of the column's quantity (listing the units it takes). OSError: the file
+            cannot be read.
     """
-    return _frame(_rotorid.read(os.fspath(path)))
+    columns, units = _rotorid.read(os.fspath(path))
+    df = _frame(columns)
+    df.attrs["units"] = dict(units)
+    return df
 
 
 def _columns(data: Any) -> dict[str, Any]:

@@ -56,7 +56,10 @@ const TIME_TOLERANCE_TEXT: &str = "1e-6";
                   rotorid identify measured.csv --scenario rig.toml --method refine --out -",
     after_long_help = concat!(
         "Input: CSV whose header names at least t,x,z; any column order; extra columns ignored;\n",
-        "a unit suffix is allowed and ignored (`x [m]`, `t (s)`); values in SI:\n",
+        "values in SI unless a column's header gives its unit (`x [um]`, `t (ms)`,\n",
+        "`phi_dot [rpm]`): then they are converted to SI and a `note:` line says so; t in\n",
+        "s, ms, us; x, z in m, mm, um, nm, mil, in; phi in rad, deg, rev; phi_dot in rad/s,\n",
+        "rpm, Hz, deg/s; phi_ddot in rad/s^2, rpm/s, Hz/s, deg/s^2. An unknown unit is an error.\n",
         "  t [s]                 strictly increasing, uniformly sampled (see --time-tolerance)\n",
         "  x, z [m]              disk displacement, horizontal and vertical\n",
         "  phi [rad], phi_dot [rad/s], phi_ddot [rad/s^2]\n",

@@ -207,6 +207,7 @@ fn read_all<R: Read>(
     profile: Option<SpeedProfile>,
 ) -> anyhow::Result<()> {
     let mut reader = ResponseReader::new(io.name, input)?;
+    reader.print_conversions();
     if !reader.has_phi() && profile.is_none() {
         return Err(CsvError::file(
             io.name,

@@ -2,20 +2,24 @@
 //! suffix), the search for required columns, and the parsing of one numeric field.
 //!
 //! Header names are compared after trimming blanks, dropping a UTF-8 byte-order mark,
-//! dropping one trailing unit suffix in brackets or parentheses (`x [m]`, `phi_dot (rad/s)`)
-//! and lower-casing, so `t,x,z`, `T [s],X [m],Z [m]` and `t (s), x (m), z (m)` all name the
-//! same columns. The unit in a suffix is not checked: values are always read as SI.
+//! splitting off one trailing unit suffix in brackets or parentheses (`x [um]`,
+//! `phi_dot (rpm)`; [`crate::units::split_unit`]) and lower-casing, so `t,x,z`,
+//! `T [s],X [m],Z [m]` and `t (s), x (m), z (m)` all name the same columns. The unit is
+//! kept ([`Header::units`]): a reader converts the columns it uses to SI with
+//! [`crate::units::conversion`] and refuses a unit it does not know for the column's role
+//! (the response reader: [`super::response`]). No suffix means SI.
 //!
 //! Limits: a line (header included) holds at most [`MAX_LINE_BYTES`] ([`super::lines`]),
 //! a number field at most [`MAX_FIELD_BYTES`]; messages quote at most a short prefix of a
-//! bad value ([`super::csv_error::quote`]).
+//! bad value ([`super::error::quote`]).
 
 use std::io::Read;
 
-use csv::ByteRecord;
-
-use super::csv_error::{abbreviate, quote, CsvError, WriteFailure};
-use super::lines::{LineReader, LineTooLong, MAX_LINE_BYTES};
+use super::error::{abbreviate, quote, CsvError, WriteFailure, QUOTE_CHARS};
+use super::lines::{LineTooLong, MAX_LINE_BYTES};
+use super::number::parse_f64;
+use super::records::{Record, RecordReader};
+use crate::units::{conversion, split_unit, Conversion, Quantity, UnitError};
 
 /// The longest number field accepted, in bytes (the shortest round-trip text of any `f64`
 /// has at most 24).
@@ -26,37 +30,54 @@ const HEADER_QUOTE_CHARS: usize = 200;
 
 /// The normalised column name (see the module doc).
 pub fn normalise(raw: &[u8]) -> String {
+    name_and_unit(raw).0
+}
+
+/// The normalised column name and the unit of its suffix, as written (trimmed), if any:
+/// `b" X [um] "` -> `("x", Some("um"))`.
+pub fn name_and_unit(raw: &[u8]) -> (String, Option<String>) {
     let s = String::from_utf8_lossy(raw);
-    let s = s.trim_start_matches('\u{feff}').trim();
-    let s = strip_unit(s, '[', ']').unwrap_or_else(|| strip_unit(s, '(', ')').unwrap_or(s));
-    s.trim().to_lowercase()
+    let (name, unit) = split_unit(s.trim_start_matches('\u{feff}'));
+    (name.to_lowercase(), unit.map(str::to_owned))
 }
 
-fn strip_unit(s: &str, open: char, close: char) -> Option<&str> {
-    if !s.ends_with(close) {
-        return None;
-    }
-    let i = s.rfind(open)?;
-    let head = s[..i].trim_end();
-    (!head.is_empty()).then_some(head)
-}
-
-/// The header of a CSV file: normalised names and the line it is on.
+/// The header of a CSV file: normalised names, their units and the line it is on.
 #[derive(Debug, Clone)]
 pub struct Header {
     /// Normalised names, in file order.
     pub names: Vec<String>,
+    /// The unit suffix of each column as written (`um`, `rpm`), `None` without one.
+    pub units: Vec<Option<String>>,
     /// 1-based line of the header.
     pub line: u64,
 }
 
 impl Header {
     /// Read from the header record `rec` found at `line`.
-    pub fn new(rec: &ByteRecord, line: u64) -> Self {
-        Self {
-            names: rec.iter().map(normalise).collect(),
-            line,
-        }
+    pub fn new(rec: &Record<'_>, line: u64) -> Self {
+        let (names, units) = rec.iter().map(name_and_unit).unzip();
+        Self { names, units, line }
+    }
+
+    /// How column `col`, holding `quantity` for the role `name`, becomes SI: from its unit
+    /// suffix (none: SI). A unit that is unknown or of another quantity is an error naming
+    /// the header line, the column and the units accepted.
+    pub fn conversion(
+        &self,
+        file: &str,
+        col: usize,
+        name: &str,
+        quantity: Quantity,
+    ) -> Result<Conversion, CsvError> {
+        let unit = self.units.get(col).and_then(Option::as_deref);
+        conversion(quantity, unit).map_err(|mut e| {
+            // the unit as written may be anything: quote a short prefix of it
+            let (UnitError::Unknown { unit, .. } | UnitError::WrongQuantity { unit, .. }) = &mut e;
+            *unit = abbreviate(unit, QUOTE_CHARS);
+            let mut err = CsvError::field(file, self.line, col, name, e.to_string());
+            err.unit = Some(Box::new(e));
+            err
+        })
     }
 
     /// Position of column `name`, or `None`. A name that appears twice is an error
@@ -113,7 +134,7 @@ impl Header {
 /// name for the message, `line` the record's line.
 pub fn finite_field(
     file: &str,
-    rec: &ByteRecord,
+    rec: &Record<'_>,
     line: u64,
     col: usize,
     name: &str,
@@ -135,7 +156,7 @@ pub fn finite_field(
 /// Parse field `col` of `rec` as an `f64` (NaN and infinity accepted).
 pub fn number_field(
     file: &str,
-    rec: &ByteRecord,
+    rec: &Record<'_>,
     line: u64,
     col: usize,
     name: &str,
@@ -154,31 +175,28 @@ pub fn number_field(
             ),
         ));
     }
-    std::str::from_utf8(raw)
-        .ok()
-        .and_then(|s| s.trim().parse::<f64>().ok())
-        .ok_or_else(|| {
-            let text = String::from_utf8_lossy(raw);
-            let what = if text.trim().is_empty() {
-                "is empty".to_owned()
-            } else {
-                format!("{} is not a number", quote(text.trim().as_bytes()))
-            };
-            CsvError::field(
-                file,
-                line,
-                col,
-                name,
-                format!("{name} {what}: expected a number"),
-            )
-        })
+    parse_f64(raw).ok_or_else(|| {
+        let text = String::from_utf8_lossy(raw);
+        let what = if text.trim().is_empty() {
+            "is empty".to_owned()
+        } else {
+            format!("{} is not a number", quote(text.trim().as_bytes()))
+        };
+        CsvError::field(
+            file,
+            line,
+            col,
+            name,
+            format!("{name} {what}: expected a number"),
+        )
+    })
 }
 
 /// An optional number: an empty field or NaN is `None` (the estimates file writes missing
 /// estimates as empty fields).
 pub fn optional_field(
     file: &str,
-    rec: &ByteRecord,
+    rec: &Record<'_>,
     line: u64,
     col: usize,
     name: &str,
@@ -191,48 +209,31 @@ pub fn optional_field(
     Ok((!v.is_nan()).then_some(v))
 }
 
-/// The CSV reader of every file here: lines numbered and capped by a [`LineReader`].
-pub type CsvReader<R> = csv::Reader<LineReader<R>>;
+/// The CSV reader of every file here: records split in place, lines numbered and capped
+/// ([`super::records`]).
+pub type CsvReader<R> = RecordReader<R>;
 
 /// A CSV reader configured as every reader here needs it: no header handling (we read the
 /// header ourselves to know its line), rows of any length (checked by the caller, with a
 /// better message), blanks trimmed around fields, lines numbered and capped
 /// ([`super::lines`]).
 pub fn csv_reader<R: Read>(input: R) -> CsvReader<R> {
-    csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .trim(csv::Trim::All)
-        .buffer_capacity(64 * 1024)
-        .from_reader(LineReader::new(input))
+    RecordReader::new(input)
 }
 
-/// Read the next record of `csv` into `rec`: the line it begins on (1-based, LF, CRLF and
-/// CR line ends alike), or `None` at the end of the input.
-pub fn next_record<R: Read>(
+/// The next record of `csv` (its line: [`Record::line`], 1-based, LF, CRLF and CR line
+/// ends alike), or `None` at the end of the input. A line over the cap names the cap; a
+/// failed write of the caller's output (flushed before a read, carrying a
+/// [`WriteFailure`]) names the output, not the input.
+pub fn next_record<'a, R: Read>(
     file: &str,
-    csv: &mut CsvReader<R>,
-    rec: &mut ByteRecord,
-) -> Result<Option<u64>, CsvError> {
-    csv.get_mut().mark();
-    match csv.read_byte_record(rec) {
-        Ok(true) => Ok(Some(csv.get_ref().record_line())),
-        Ok(false) => Ok(None),
-        Err(e) => Err(read_error(file, e, csv.get_ref().line())),
-    }
+    csv: &'a mut CsvReader<R>,
+) -> Result<Option<Record<'a>>, CsvError> {
+    csv.next_record()
+        .map_err(|e| io_error(file, &e.error, e.line))
 }
 
-/// Map a `csv` crate error (I/O, mostly) met at `line` to a [`CsvError`] for `file`. A
-/// line over the cap names the cap; a failed write of the output (flushed before a read,
-/// see [`super::FlushBeforeRead`]) names the output, not the input.
-pub fn read_error(file: &str, e: csv::Error, line: u64) -> CsvError {
-    match e.kind() {
-        csv::ErrorKind::Io(io) => io_error(file, io, line),
-        _ => CsvError::line(file, line, format!("cannot read: {e}")),
-    }
-}
-
-/// [`read_error`] for an I/O error met at `line` of `file`.
+/// The [`CsvError`] of an I/O error met at `line` of `file` (see [`next_record`]).
 pub fn io_error(file: &str, io: &std::io::Error, line: u64) -> CsvError {
     let inner = io.get_ref();
     if let Some(t) = inner.and_then(|i| i.downcast_ref::<LineTooLong>()) {
@@ -267,7 +268,7 @@ pub fn io_error(file: &str, io: &std::io::Error, line: u64) -> CsvError {
 /// Check that a record has as many fields as the header.
 pub fn check_length(
     file: &str,
-    rec: &ByteRecord,
+    rec: &Record<'_>,
     line: u64,
     header: &Header,
 ) -> Result<(), CsvError> {
@@ -291,8 +292,22 @@ pub fn check_length(
 mod tests {
     use super::*;
 
+    /// A reader of the one line `fields` joined by commas.
+    fn line_of(fields: &[&str]) -> RecordReader<std::io::Cursor<Vec<u8>>> {
+        RecordReader::new(std::io::Cursor::new(fields.join(",").into_bytes()))
+    }
+
     #[test]
-    fn names_drop_units_case_and_blanks() {
+    fn names_split_units_drop_case_and_blanks() {
+        assert_eq!(
+            name_and_unit(" X [um] ".as_bytes()),
+            ("x".to_owned(), Some("um".to_owned()))
+        );
+        assert_eq!(
+            name_and_unit("\u{feff}t (ms)".as_bytes()),
+            ("t".to_owned(), Some("ms".to_owned()))
+        );
+        assert_eq!(name_and_unit(b"Phi_Dot"), ("phi_dot".to_owned(), None));
         assert_eq!(normalise(b" x [m] "), "x");
         assert_eq!(normalise(b"phi_dot (rad/s)"), "phi_dot");
         assert_eq!(normalise("\u{feff}T".as_bytes()), "t");
@@ -303,7 +318,8 @@ mod tests {
     #[test]
     fn long_fields_and_headers_are_quoted_short() {
         let long = "9".repeat(2000);
-        let rec = ByteRecord::from(vec![long.as_str(), "x".repeat(500).as_str()]);
+        let mut r = line_of(&[long.as_str(), "x".repeat(500).as_str()]);
+        let rec = r.next_record().unwrap().unwrap();
         let e = finite_field("f", &rec, 2, 0, "t").unwrap_err().to_string();
         assert!(
             e.starts_with("f line 2, column 1 (t): t \"9999")
@@ -317,9 +333,31 @@ mod tests {
         );
         assert!(e.len() < 200, "{e}");
         let names = vec!["q".repeat(10_000); 3];
-        let h = Header::new(&ByteRecord::from(names), 1);
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let mut r = line_of(&names);
+        let h = Header::new(&r.next_record().unwrap().unwrap(), 1);
         let e = h.require("f", &["t", "x", "z"]).unwrap_err().to_string();
         assert!(e.len() < 400 && e.ends_with("(30002 bytes in all))"), "{e}");
+    }
+
+    #[test]
+    fn a_long_unit_is_quoted_short() {
+        let header = format!("x [{}]", "\u{7}".repeat(10_000));
+        let mut r = line_of(&[header.as_str()]);
+        let h = Header::new(&r.next_record().unwrap().unwrap(), 1);
+        let e = h
+            .conversion("f", 0, "x", Quantity::Displacement)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("f line 1, column 1 (x): unknown unit \"\\u{7}"),
+            "{e}"
+        );
+        assert!(
+            e.contains("... (10000 bytes in all)\" for a displacement"),
+            "{e}"
+        );
+        assert!(e.len() < 400, "{} bytes: {e}", e.len());
     }
 
     #[test]
@@ -331,10 +369,9 @@ mod tests {
             "h\n1\n\n2",
         ] {
             let mut csv = csv_reader(text.as_bytes());
-            let mut rec = ByteRecord::new();
             let mut lines = Vec::new();
-            while let Some(l) = next_record("f", &mut csv, &mut rec).unwrap() {
-                lines.push((l, rec.get(0).unwrap().to_vec()));
+            while let Some(rec) = next_record("f", &mut csv).unwrap() {
+                lines.push((rec.line(), rec.get(0).unwrap().to_vec()));
             }
             assert_eq!(
                 lines,
@@ -346,7 +383,8 @@ mod tests {
 
     #[test]
     fn fields_parse_or_say_why_not() {
-        let rec = ByteRecord::from(vec!["1.5", "abc", "", "NaN", "inf"]);
+        let mut r = line_of(&["1.5", "abc", "", "NaN", "inf"]);
+        let rec = r.next_record().unwrap().unwrap();
         assert_eq!(finite_field("f", &rec, 2, 0, "t").unwrap(), 1.5);
         let e = finite_field("f", &rec, 2, 1, "x").unwrap_err();
         assert_eq!(

@@ -11,6 +11,8 @@
 
 use std::fmt;
 
+use crate::units::UnitError;
+
 /// Most characters of a value that a message quotes.
 pub const QUOTE_CHARS: usize = 40;
 
@@ -34,6 +36,10 @@ pub fn abbreviate(text: &str, max_chars: usize) -> String {
 }
 
 /// A CSV input that cannot be used, and where.
+///
+/// A located message rather than an enum of causes: every reader builds its own message
+/// (what is wrong, the value, what is allowed); the parts a caller acts on are fields
+/// ([`CsvError::io_kind`] for a broken pipe, [`CsvError::unit`] for a unit the file gives).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CsvError {
     /// The file name as given on the command line (`<stdin>` for `-`).
@@ -47,6 +53,9 @@ pub struct CsvError {
     /// Set when the failure was an I/O error (e.g. a broken pipe on the output, which a
     /// flush-before-read input reports), so a command can react to its kind.
     pub io_kind: Option<std::io::ErrorKind>,
+    /// Set when the failure is a unit in the header that the column's role cannot take (its
+    /// text is in the message too).
+    pub unit: Option<Box<UnitError>>,
 }
 
 impl CsvError {
@@ -58,6 +67,7 @@ impl CsvError {
             column: None,
             message: message.into(),
             io_kind: None,
+            unit: None,
         }
     }
 
@@ -98,12 +108,13 @@ impl fmt::Display for CsvError {
     }
 }
 
+// No `source`: the message already holds the cause's text, and `{:#}` would repeat it.
 impl std::error::Error for CsvError {}
 
-/// The payload of every `io::Error` an output ([`super::Output`]) returns: it remembers
-/// which output failed, so that a write error a reader meets (the output is flushed before
-/// each read of the input, see [`super::FlushBeforeRead`]) is reported against the output,
-/// not the input. Its `Display` is the underlying error's, so `cannot write NAME: {e}`
+/// The payload of every `io::Error` a caller's output returns (the `rotorid` command's
+/// `Output`): it remembers which output failed, so that a write error a reader meets (a
+/// command may flush its output before each read of the input) is reported against the
+/// output, not the input. Its `Display` is the underlying error's, so `cannot write NAME: {e}`
 /// reads as for a plain I/O error.
 #[derive(Debug)]
 pub struct WriteFailure {
