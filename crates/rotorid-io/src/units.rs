@@ -67,6 +67,14 @@ impl Quantity {
         }
     }
 
+    /// `a` or `an`, for the quantity's name in messages.
+    pub fn article(self) -> &'static str {
+        match self {
+            Quantity::Angle | Quantity::AngularSpeed | Quantity::AngularAcceleration => "an",
+            _ => "a",
+        }
+    }
+
     /// The quantity's name in messages.
     pub fn name(self) -> &'static str {
         match self {
@@ -156,7 +164,7 @@ impl Conversion {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum UnitError {
     /// The unit is not one we know.
-    #[error("unknown unit {unit:?} for a {expected}: use one of {accepted}", accepted = expected.accepted())]
+    #[error("unknown unit {unit:?} for {} {expected}: use one of {accepted}", expected.article(), accepted = expected.accepted())]
     Unknown {
         /// The unit as written.
         unit: String,
@@ -164,7 +172,7 @@ pub enum UnitError {
         expected: Quantity,
     },
     /// The unit is known but measures something else.
-    #[error("unit {unit:?} is a {found} unit, but this channel holds a {expected}: use one of {accepted}", accepted = expected.accepted())]
+    #[error("unit {unit:?} is {} {found} unit, but this channel holds {} {expected}: use one of {accepted}", found.article(), expected.article(), accepted = expected.accepted())]
     WrongQuantity {
         /// The unit as written.
         unit: String,

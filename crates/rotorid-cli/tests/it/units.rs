@@ -186,8 +186,8 @@ fn unknown_and_wrong_units_are_refused_with_what_is_accepted() {
         ),
         (
             "t,x,z,phi,phi_dot [deg],phi_ddot\n0,0,0,0,0,0\n",
-            "Error: <stdin> line 1, column 5 (phi_dot): unit \"deg\" is a angle unit, but this \
-             channel holds a angular speed: use one of rad/s, rpm, Hz (rev/s), deg/s\n",
+            "Error: <stdin> line 1, column 5 (phi_dot): unit \"deg\" is an angle unit, but this \
+             channel holds an angular speed: use one of rad/s, rpm, Hz (rev/s), deg/s\n",
         ),
         (
             "t [h],x,z\n0,0,0\n",

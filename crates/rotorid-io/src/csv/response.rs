@@ -371,7 +371,7 @@ mod tests {
         );
         assert_eq!(
             err("\nt,z,x [rpm]\n"),
-            "d.csv line 2, column 3 (x): unit \"rpm\" is a angular speed unit, but this channel \
+            "d.csv line 2, column 3 (x): unit \"rpm\" is an angular speed unit, but this channel \
              holds a displacement: use one of m, mm, um (µm), nm, mil, in"
         );
         let e = ResponseReader::new(
