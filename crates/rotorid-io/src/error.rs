@@ -30,14 +30,9 @@ pub enum ReadError {
         /// The extensions read here.
         known: &'static str,
     },
-    /// A format another reader handles (CSV).
-    #[error("{file}: {format} is read by the CSV reader, not by rotorid_io::read_table")]
-    NotHandledHere {
-        /// The file.
-        file: String,
-        /// The format.
-        format: &'static str,
-    },
+    /// A CSV file that cannot be read as a table.
+    #[error(transparent)]
+    Csv(Box<crate::csv::CsvError>),
     /// A field or block extends past the end of the file (a truncated file, or a length or
     /// dimension field larger than the file).
     #[error(
@@ -142,13 +137,13 @@ impl ReadError {
         match self {
             ReadError::Io { file, .. }
             | ReadError::UnknownFormat { file, .. }
-            | ReadError::NotHandledHere { file, .. }
             | ReadError::Truncated { file, .. }
             | ReadError::Invalid { file, .. }
             | ReadError::NotUtf8 { file, .. }
             | ReadError::InexactInteger { file, .. }
             | ReadError::NoChannels { file, .. }
             | ReadError::Container { file, .. } => file,
+            ReadError::Csv(e) => &e.file,
         }
     }
 }

@@ -21,7 +21,8 @@ pub enum Format {
     Npz,
     /// Apache `.parquet`: [`crate::parquet`].
     Parquet,
-    /// `.csv`, `.txt`, `.tsv`: read by the CSV reader, not by [`read_table`].
+    /// `.csv`, `.txt`, `.tsv`: [`crate::csv::read_csv_table`] (the response CSV is also
+    /// streamed by [`crate::csv::ResponseReader`]).
     Csv,
 }
 
@@ -60,10 +61,12 @@ pub fn read_table(path: impl AsRef<Path>) -> Result<Table, ReadError> {
     let file = path.display().to_string();
     let format = Format::from_path(path)?;
     if format == Format::Csv {
-        return Err(ReadError::NotHandledHere {
-            file,
-            format: "CSV",
-        });
+        let f = std::fs::File::open(path).map_err(|source| ReadError::Io {
+            file: file.clone(),
+            source,
+        })?;
+        return crate::csv::read_csv_table(&file, std::io::BufReader::with_capacity(1 << 16, f))
+            .map_err(|e| ReadError::Csv(Box::new(e)));
     }
     let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
         file: file.clone(),
@@ -82,9 +85,8 @@ pub fn read_bytes(format: Format, file: &str, bytes: &[u8]) -> Result<Table, Rea
         Format::Tdms => crate::tdms::read(file, bytes),
         Format::Uff58 => crate::uff::read(file, bytes),
         Format::Parquet => crate::parquet::read(file, bytes),
-        Format::Csv => Err(ReadError::NotHandledHere {
-            file: file.to_string(),
-            format: "CSV",
-        }),
+        Format::Csv => {
+            crate::csv::read_csv_table(file, bytes).map_err(|e| ReadError::Csv(Box::new(e)))
+        }
     }
 }

@@ -9,8 +9,9 @@
 //!
 //! [`read_table`] picks the reader by the file's extension ([`Format::from_path`]):
 //! [`mat`] (`.mat`, level 5 and v7.3), [`tdms`], [`uff`] (`.uff`, `.unv`, `.58`), [`npy`],
-//! [`npz`], [`parquet`]. CSV is read elsewhere. Every reader takes the whole file's bytes,
-//! checks each length and dimension field against them before allocating, and fails with a
+//! [`npz`], [`parquet`] and CSV ([`csv::read_csv_table`]; the response CSV is also streamed
+//! by [`csv::ResponseReader`]). Every binary reader takes the whole file's bytes, checks
+//! each length and dimension field against them before allocating, and fails with a
 //! [`ReadError`] that names the file, the channel and the byte offset; none panics on any
 //! input (each has a cargo-fuzz target in `fuzz/`).
 //!
@@ -31,8 +32,8 @@
 // match on them; it is returned once per failed read, so its size costs nothing measurable.
 #![allow(clippy::result_large_err)]
 
-mod cursor;
 pub mod csv;
+mod cursor;
 pub mod error;
 pub mod format;
 pub mod mat;

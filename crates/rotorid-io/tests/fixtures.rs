@@ -159,6 +159,17 @@ fn extensions_pick_readers() {
         e.to_string().contains("rec.xlsx") && e.to_string().contains(".tdms"),
         "{e}"
     );
-    let e = read_table("rec.csv").unwrap_err();
-    assert!(matches!(e, ReadError::NotHandledHere { .. }), "{e}");
+    // a CSV goes to the CSV table reader; a missing one is an I/O error naming it
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("rec.csv");
+    std::fs::write(&p, "t [ms],x [um]\n0,1.5\n0.1,2\n").unwrap();
+    let t = read_table(&p).unwrap();
+    assert_eq!(t.channels[1].name, "x");
+    assert_eq!(t.channels[1].unit.as_deref(), Some("um"));
+    assert_eq!(t.channels[1].data, [1.5, 2.0]);
+    let e = read_table(dir.path().join("none.csv")).unwrap_err();
+    assert!(
+        matches!(e, ReadError::Io { .. }) && e.to_string().contains("none.csv"),
+        "{e}"
+    );
 }

@@ -16,6 +16,8 @@ pub mod lines;
 pub mod number;
 pub mod records;
 pub mod response;
+pub mod table;
 
 pub use error::{CsvError, WriteFailure};
 pub use response::{ResponseReader, ResponseRow, Speed, RESPONSE_HEADER};
+pub use table::read_csv_table;
