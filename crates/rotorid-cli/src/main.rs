@@ -34,6 +34,10 @@ enum Command {
     Analyze(commands::analyze::AnalyzeArgs),
     /// Correction mass for single-plane balancing (identified unbalance or two runs).
     Balance(commands::balance::BalanceArgs),
+    /// Turn a raw acquisition (probe volts, keyphasor, slow roll) into a response CSV.
+    Condition(commands::condition::ConditionArgs),
+    /// List the channels of a record (CSV, MAT, TDMS, UFF58, NPY/NPZ, Parquet).
+    Inspect(commands::inspect::InspectArgs),
 }
 
 fn main() {
@@ -46,6 +50,8 @@ fn main() {
         Command::Plot(args) => commands::plot::run(args),
         Command::Analyze(args) => commands::analyze::run(args),
         Command::Balance(args) => commands::balance::run(args),
+        Command::Condition(args) => commands::condition::run(args),
+        Command::Inspect(args) => commands::inspect::run(args),
     };
     if let Err(err) = result {
         eprintln!("Error: {err:#}");

@@ -12,6 +12,7 @@ pub use args::IdentifyArgs;
 use anyhow::Context as _;
 use args::method_of;
 
+use crate::io::tables;
 use crate::io::LoadScenario as _;
 use crate::io::{check_distinct_files, is_broken_pipe, open_input, FileMode, Output, ScenarioSpec};
 
@@ -27,7 +28,37 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         &outputs,
     )?;
     let spec = ScenarioSpec::load(&args.scenario)?;
-    let (name, input) = open_input(&args.input)?;
+    let columns = args.columns.as_deref();
+    let (name, input) = if let Some(acq) = spec.acquisition() {
+        // a raw acquisition: conditioned in two passes, then identified
+        let table = tables::read(&args.input)?;
+        let raw = tables::raw_record(&table, acq)?;
+        let slow = tables::slow_roll(&spec, acq)?;
+        let c = tables::condition_for(
+            &raw,
+            acq,
+            slow.as_ref(),
+            &spec,
+            &spec.knowledge()?,
+            Some(&method),
+        )?;
+        tables::print_report(&c);
+        let cols = tables::conditioned_columns(c);
+        (args.input.clone(), stream::Source::Columns(cols))
+    } else if tables::is_tabular(&args.input, columns) {
+        let table = tables::read(&args.input)?;
+        let cols = tables::columns(&table, columns)?;
+        (args.input.clone(), stream::Source::Columns(cols))
+    } else {
+        if columns.is_some() {
+            anyhow::bail!(
+                "--columns needs a file (it is read whole), not {}",
+                args.input
+            );
+        }
+        let (name, input) = open_input(&args.input)?;
+        (name, stream::Source::Csv(input))
+    };
     let live = args.input == "-" || !std::fs::metadata(&args.input).is_ok_and(|m| m.is_file());
     let out = Output::create(&args.out, FileMode::Direct)?;
     let to_stdout = out.is_stdout();

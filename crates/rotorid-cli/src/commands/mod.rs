@@ -2,8 +2,10 @@
 
 pub mod analyze;
 pub mod balance;
+pub mod condition;
 pub mod demo;
 pub mod identify;
+pub mod inspect;
 pub mod paper;
 pub mod plot;
 pub mod simulate;

@@ -94,9 +94,20 @@ pub struct SimulateArgs {
     pub initial_vz: Option<f64>,
 
     /// Output CSV file, or `-` for stdout. A file is written to a temporary name and
-    /// renamed when complete, so a failed run never leaves a truncated file.
-    #[arg(long, short, value_name = "FILE.csv|-")]
+    /// renamed when complete, so a failed run never leaves a truncated file. A `.parquet`,
+    /// `.mat` (level 5) or `.npz` file gets the same channels in that format (SI units).
+    #[arg(long, short, value_name = "FILE.csv|-|FILE.parquet|FILE.mat|FILE.npz")]
     pub out: String,
+
+    /// Write the raw acquisition of the scenario's [acquisition] instead of the response:
+    /// probe voltages with gap, runout, noise and quantisation, the keyphasor pulse train
+    /// and the time column, as its [acquisition.simulate] settings say (docs/acquisition.md).
+    #[arg(long)]
+    pub raw: bool,
+
+    /// With --raw: also write the matching slow-roll record to this file.
+    #[arg(long, value_name = "FILE", requires = "raw")]
+    pub slow_roll_out: Option<String>,
 
     /// Do not print the noise level on stderr.
     #[arg(long, short)]
@@ -135,6 +146,13 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
     })?;
     let method = Method::from(args.method);
     let n = scenario.sampling.samples();
+    if args.raw {
+        return write_raw(&args, &spec, &scenario);
+    }
+    let format = rotorid_io::Format::from_path(std::path::Path::new(&args.out));
+    if args.out != "-" && !matches!(format, Ok(rotorid_io::Format::Csv) | Err(_)) {
+        return write_table_file(&args, &scenario, method);
+    }
     let out = Output::create(&args.out, FileMode::Atomic)?;
     let to_stdout = out.is_stdout();
     let result = write_response(&args, &scenario, method, n, out);
@@ -142,6 +160,126 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         Err(e) if to_stdout && is_broken_pipe(&e) => Ok(()),
         r => r,
     }
+}
+
+/// The response as a table of SI channels t, x, z, phi, phi_dot, phi_ddot.
+fn response_table(file: &str, r: TimeResponse) -> rotorid_io::Table {
+    let unit = ["s", "m", "m", "rad", "rad/s", "rad/s^2"];
+    let data = [r.t, r.x, r.z, r.phi, r.phi_dot, r.phi_ddot];
+    rotorid_io::Table {
+        file: file.to_owned(),
+        channels: ["t", "x", "z", "phi", "phi_dot", "phi_ddot"]
+            .into_iter()
+            .zip(data)
+            .zip(unit)
+            .map(|((name, data), u)| rotorid_io::Channel {
+                name: name.to_owned(),
+                unit: Some(u.to_owned()),
+                data,
+                axis: None,
+            })
+            .collect(),
+    }
+}
+
+/// `--out` in a binary format: the whole response, then the file.
+fn write_table_file(
+    args: &SimulateArgs,
+    scenario: &rotorid::Scenario,
+    method: Method,
+) -> anyhow::Result<()> {
+    let mut resp = rotorid::simulate::simulate(scenario, method)?;
+    if let Some(snr_db) = args.snr_db {
+        let seed = args.seed.unwrap_or(0);
+        let level = add_noise(&mut resp, snr_db, seed)?;
+        if !args.quiet {
+            eprintln!(
+                "added white noise at SNR {snr_db} dB (seed {seed}): sigma_x = {:e} m, \
+                 sigma_z = {:e} m",
+                level.sigma_x, level.sigma_z
+            );
+        }
+    }
+    rotorid_io::write_table(&args.out, &response_table(&args.out, resp))?;
+    Ok(())
+}
+
+/// A raw record as a table (names as the acquisition gives them; volts and s).
+fn raw_table(file: &str, raw: rotorid::acquisition::RawRecord) -> rotorid_io::Table {
+    rotorid_io::Table {
+        file: file.to_owned(),
+        channels: raw
+            .columns
+            .into_iter()
+            .map(|(name, data)| rotorid_io::Channel {
+                name,
+                unit: None,
+                data,
+                axis: None,
+            })
+            .collect(),
+    }
+}
+
+/// Write `t` to `path`: CSV (header = names, shortest round-trip numbers) or a binary
+/// format by the extension.
+fn write_any(path: &str, t: &rotorid_io::Table) -> anyhow::Result<()> {
+    let format = rotorid_io::Format::from_path(std::path::Path::new(path));
+    if path != "-" && !matches!(format, Ok(rotorid_io::Format::Csv) | Err(_)) {
+        rotorid_io::write_table(path, t)?;
+        return Ok(());
+    }
+    let mut out = Output::create(path, FileMode::Atomic)?;
+    let names: Vec<&str> = t.channels.iter().map(|c| c.name.as_str()).collect();
+    let mut text = Vec::with_capacity(64);
+    use std::io::Write as _;
+    writeln!(out, "{}", names.join(",")).with_context(|| format!("cannot write {path}"))?;
+    let n = t.channels.first().map_or(0, |c| c.data.len());
+    for i in 0..n {
+        text.clear();
+        for (j, c) in t.channels.iter().enumerate() {
+            if j > 0 {
+                text.push(b',');
+            }
+            crate::io::number::push_f64(&mut text, c.data[i]);
+        }
+        text.push(b'\n');
+        out.write_all(&text)
+            .with_context(|| format!("cannot write {path}"))?;
+    }
+    out.commit()
+}
+
+/// `--raw`: the raw acquisition of the scenario's [acquisition] (and its slow roll).
+fn write_raw(
+    args: &SimulateArgs,
+    spec: &ScenarioSpec,
+    scenario: &rotorid::Scenario,
+) -> anyhow::Result<()> {
+    let Some(acq) = spec.acquisition() else {
+        anyhow::bail!(
+            "--raw needs an [acquisition] table in the scenario {} (probes, keyphasor; see \
+             docs/acquisition.md)",
+            spec.origin()
+        );
+    };
+    let sim = rotorid::acquisition::simulate_raw(scenario, acq)?;
+    if !args.quiet {
+        eprintln!(
+            "raw acquisition: noise sigma_x = {:e} m, sigma_z = {:e} m on the displacements",
+            sim.noise.sigma_x, sim.noise.sigma_z
+        );
+    }
+    if let Some(path) = &args.slow_roll_out {
+        let Some(slow) = sim.slow_roll else {
+            anyhow::bail!(
+                "--slow-roll-out: the scenario's [acquisition.simulate] has no slow roll \
+                 (slow_roll_rpm)"
+            );
+        };
+        write_any(path, &raw_table(path, slow))?;
+    }
+    write_any(&args.out, &raw_table(&args.out, sim.running))
 }
 
 fn write_response(

@@ -25,6 +25,7 @@ pub mod params;
 pub mod progress;
 pub mod response_csv;
 pub mod scenario;
+pub mod tables;
 
 pub use estimates_csv::{EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES_HEADER};
 pub use output::{check_distinct_files, is_broken_pipe, open_input, FileMode, Output};

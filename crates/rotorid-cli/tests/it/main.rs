@@ -4,6 +4,7 @@ mod common;
 
 mod analysis;
 mod demo;
+mod formats;
 mod golden;
 mod identify;
 mod modulating;

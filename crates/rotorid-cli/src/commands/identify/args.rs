@@ -122,9 +122,18 @@ const TIME_TOLERANCE_TEXT: &str = "1e-6";
     )
 )]
 pub struct IdentifyArgs {
-    /// The response CSV, or `-` for stdin.
-    #[arg(value_name = "INPUT.csv|-")]
+    /// The record: a response CSV (streamed; `-` for stdin), or a .mat, .tdms, .uff/.unv/.58,
+    /// .npy, .npz or .parquet file (read whole). With a scenario that has [acquisition], a
+    /// raw acquisition (probe volts and keyphasor) conditioned before identification.
+    #[arg(value_name = "INPUT|-")]
     pub input: String,
+
+    /// The channels that play t, x, z (and phi, phi_dot, phi_ddot): `t,x,z` or six names,
+    /// e.g. `rec.t,rec.x,rec.z` (MAT struct fields), `g/x` (TDMS), `0,1,2` (2-D NPY). A
+    /// name alone finds a struct field or TDMS channel when it is unique. Default: the
+    /// role names. Units come from the file (CSV header suffix, TDMS unit_string, UFF58).
+    #[arg(long, value_name = "T,X,Z[,PHI,PHI_DOT,PHI_DDOT]")]
+    pub columns: Option<String>,
 
     /// The scenario: `table1` (built in) or a TOML file. Needs the known a, m_u, d,
     /// alpha_deg; m, cx, cz, kx, kz are optional (truth, for the error report; refine:

@@ -120,11 +120,22 @@ impl<R: Read> Read for HookedInput<R> {
     }
 }
 
+/// Where the samples come from: a response CSV read as it streams, or columns already in
+/// memory and in SI (a binary file, a CSV read whole for `--columns`, a conditioned raw
+/// record).
+pub(crate) enum Source {
+    /// The response CSV (a file or a live pipe).
+    Csv(Box<dyn Read>),
+    /// t \[s\], x, z \[m\] and optional phi \[rad\], phi_dot \[rad/s\], phi_ddot
+    /// \[rad/s^2\].
+    Columns(rotorid_io::SiColumns),
+}
+
 /// Read `input`, identify it by `method` with what `spec` knows, write the estimates CSV
 /// to `out` (committed on success; complete rows on error) and return the result.
 pub(crate) fn identify(
     io: &Io,
-    input: Box<dyn Read>,
+    input: Source,
     out: Output,
     spec: &ScenarioSpec,
     method: &Method,
@@ -155,12 +166,17 @@ pub(crate) fn identify(
             error: None,
         },
     }));
-    let hooked = HookedInput {
-        inner: input,
-        state: Rc::clone(&state),
-        live: io.live,
+    let result = match input {
+        Source::Csv(input) => {
+            let hooked = HookedInput {
+                inner: input,
+                state: Rc::clone(&state),
+                live: io.live,
+            };
+            read_all(io, hooked, &state, profile)
+        }
+        Source::Columns(cols) => push_columns(io, &cols, &state, profile),
     };
-    let result = read_all(io, hooked, &state, profile);
     let State { session, mut rows } = Rc::try_unwrap(state)
         .map_err(|_| anyhow::anyhow!("the input still holds the session"))?
         .into_inner();
@@ -231,6 +247,47 @@ fn read_all<R: Read>(
                 _ => "",
             };
             CsvError::line(io.name, row.line, format!("{e}{hint}"))
+        })?;
+        if let Some(e) = st.rows.error.take() {
+            return Err(e).with_context(|| format!("cannot write {}", io.out_name));
+        }
+    }
+    Ok(())
+}
+
+/// Every sample of `cols` into the session (sample i named as such in messages).
+fn push_columns(
+    io: &Io,
+    cols: &rotorid_io::SiColumns,
+    state: &Rc<RefCell<State>>,
+    profile: Option<SpeedProfile>,
+) -> anyhow::Result<()> {
+    if cols.speed.is_none() && profile.is_none() {
+        anyhow::bail!(
+            "{}: has no phi, phi_dot, phi_ddot channels and the scenario has no [speed] \
+             section: give the rotor angle in the data (--columns t,x,z,phi,phi_dot,phi_ddot) \
+             or the speed profile in the scenario",
+            io.name
+        );
+    }
+    for i in 0..cols.x.len() {
+        let s = Sample {
+            t: Some(cols.t[i]),
+            x: cols.x[i],
+            z: cols.z[i],
+            speed: cols.speed.as_ref().map(|[p, w, a]| rotorid::SpeedState {
+                phi: p[i],
+                omega: w[i],
+                omega_dot: a[i],
+            }),
+        };
+        let mut st = state.borrow_mut();
+        st.push(&s).map_err(|e| {
+            let hint = match e {
+                PipelineError::NonUniformSampling { .. } => " (--time-tolerance)",
+                _ => "",
+            };
+            anyhow::anyhow!("{}, sample {i} (t = {} s): {e}{hint}", io.name, cols.t[i])
         })?;
         if let Some(e) = st.rows.error.take() {
             return Err(e).with_context(|| format!("cannot write {}", io.out_name));

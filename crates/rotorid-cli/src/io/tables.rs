@@ -1,0 +1,153 @@
+//! Records in any format `rotorid_io` reads (MAT, TDMS, UFF58, NPY/NPZ, Parquet, CSV read
+//! whole): the channels that play t, x, z, phi... (`--columns`, units converted to SI), and
+//! raw acquisitions (probe volts and keyphasor) conditioned by the library
+//! (`rotorid::acquisition`) before identification.
+
+use std::path::Path;
+
+use anyhow::Context as _;
+use rotorid::acquisition::{
+    condition, Acquisition, Conditioned, GuessSource, ModelGuess, RawRecord,
+};
+use rotorid::pipeline::{identify, Knowledge, Method, Record};
+use rotorid::scenario_file::ScenarioSpec;
+use rotorid_io::units::{conversion, Quantity};
+use rotorid_io::{select, ColumnMap, Format, SiColumns, Table};
+
+/// True when `input` is read whole as a table rather than streamed as a response CSV: a
+/// regular file whose extension is not a CSV one, or any file with `--columns`.
+pub fn is_tabular(input: &str, columns: Option<&str>) -> bool {
+    if input == "-" {
+        return false;
+    }
+    let regular = std::fs::metadata(input).is_ok_and(|m| m.is_file());
+    let csv = matches!(
+        Format::from_path(Path::new(input)),
+        Ok(Format::Csv) | Err(_)
+    );
+    regular && (!csv || columns.is_some())
+}
+
+/// The table of the file at `path` (its format from its extension).
+pub fn read(path: &str) -> anyhow::Result<Table> {
+    Ok(rotorid_io::read_table(path)?)
+}
+
+/// The channels of `table` that play t, x, z and (when present) phi, phi_dot, phi_ddot, in
+/// SI; `columns` is the `--columns` text. Each converted channel is noted on stderr.
+pub fn columns(table: &Table, columns: Option<&str>) -> anyhow::Result<SiColumns> {
+    let map = match columns {
+        Some(spec) => ColumnMap::parse(spec)?,
+        None => ColumnMap::default(),
+    };
+    let cols = select(table, &map)?;
+    for u in cols.used.iter().filter(|u| !u.conversion.is_identity()) {
+        eprintln!(
+            "note: {}: {} ({}) in {}, converted to {} (x {:e})",
+            table.file,
+            u.channel,
+            u.role,
+            u.conversion.unit,
+            u.conversion.quantity.si(),
+            u.conversion.factor()
+        );
+    }
+    if cols.time_from_axis {
+        eprintln!(
+            "note: {}: time from the file's time axis (no time channel)",
+            table.file
+        );
+    }
+    Ok(cols)
+}
+
+/// The raw record of `table` for `acq`: every channel by name, the ones `acq` uses in SI
+/// (time in s, probes and keyphasor in V, from their units).
+pub fn raw_record(table: &Table, acq: &Acquisition) -> anyhow::Result<RawRecord> {
+    let mut columns = Vec::with_capacity(table.channels.len());
+    for c in &table.channels {
+        let role = acq.columns().into_iter().find(|(n, _)| *n == c.name);
+        let mut data = c.data.clone();
+        if let Some((_, what)) = role {
+            let q = if what == "time" {
+                Quantity::Time
+            } else {
+                Quantity::Voltage
+            };
+            let conv = conversion(q, c.unit.as_deref())
+                .with_context(|| format!("{}, channel {:?} ({what})", table.file, c.name))?;
+            conv.apply_all(&mut data);
+        }
+        columns.push((c.name.clone(), data));
+    }
+    Ok(RawRecord { columns })
+}
+
+/// The slow-roll record of `acq`, read from its path relative to the scenario file.
+pub fn slow_roll(spec: &ScenarioSpec, acq: &Acquisition) -> anyhow::Result<Option<RawRecord>> {
+    let Some(rel) = &acq.slow_roll else {
+        return Ok(None);
+    };
+    let base = Path::new(spec.origin()).parent().unwrap_or(Path::new("."));
+    let path = base.join(rel);
+    let table = read(&path.to_string_lossy())
+        .with_context(|| format!("the slow-roll record of [acquisition.runout] ({rel})"))?;
+    Ok(Some(raw_record(&table, acq)?))
+}
+
+/// The scenario's rotor as a guess for the conditioning, when it states m, cx, kx, cz, kz.
+pub fn scenario_guess(spec: &ScenarioSpec) -> Option<ModelGuess> {
+    let sc = spec
+        .simulation(&Default::default())
+        .ok()
+        .filter(|_| spec.knowledge().is_ok_and(|k| k.truth.is_some()))?;
+    Some(ModelGuess {
+        rotor: sc.rotor.params(),
+        initial: None,
+        source: GuessSource::Scenario,
+    })
+}
+
+/// Condition `raw` for `acq`; with `method`, in two passes (docs/acquisition.md): the first
+/// conditioned record is identified, and its estimate is the rotor guess of the second.
+pub fn condition_for(
+    raw: &RawRecord,
+    acq: &Acquisition,
+    slow: Option<&RawRecord>,
+    spec: &ScenarioSpec,
+    knowledge: &Knowledge,
+    method: Option<&Method>,
+) -> anyhow::Result<Conditioned> {
+    let first = condition(raw, acq, slow, scenario_guess(spec).as_ref())?;
+    let Some(method) = method else {
+        return Ok(first);
+    };
+    let rec = Record::from_response(&first.response())?;
+    let id = identify(&rec, knowledge, method)?;
+    match ModelGuess::from_identification(&id, knowledge) {
+        Some(g) => Ok(condition(raw, acq, slow, Some(&g))?),
+        None => Ok(first),
+    }
+}
+
+/// `c` as the columns of a record (SI already).
+pub fn conditioned_columns(c: Conditioned) -> SiColumns {
+    SiColumns {
+        t: c.t,
+        x: c.x,
+        z: c.z,
+        speed: Some([c.phi, c.phi_dot, c.phi_ddot]),
+        used: Vec::new(),
+        time_from_axis: false,
+    }
+}
+
+/// The conditioning's findings as `warning:` lines and its notes as `note:` lines.
+pub fn print_report(c: &Conditioned) {
+    for n in &c.report.notes {
+        eprintln!("note: {n}");
+    }
+    for f in &c.report.findings {
+        eprintln!("warning: {}", f.message());
+    }
+}

@@ -1,0 +1,211 @@
+//! Records in every format rotorid reads: the same record written as CSV, Parquet, MAT and
+//! NPZ (by `rotorid simulate --out`, whose writers are checked against numpy, scipy and
+//! pyarrow in crates/rotorid-io/tests) identifies bit for bit alike; `--columns` picks
+//! channels by other names; `inspect` lists a file's channels; a raw acquisition (probe
+//! volts, keyphasor, slow roll) is conditioned and identified within its standard errors.
+
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::common::{data, rotorid};
+
+fn run(args: &[&str]) -> (String, String) {
+    let out = rotorid().args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "rotorid {args:?}: {stderr}");
+    (String::from_utf8_lossy(&out.stdout).into_owned(), stderr)
+}
+
+fn summary(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn every_format_identifies_bit_for_bit_like_the_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_string_lossy().into_owned();
+    let mut results = Vec::new();
+    for ext in ["csv", "parquet", "mat", "npz"] {
+        let rec = p(&format!("r.{ext}"));
+        run(&[
+            "simulate",
+            "--scenario",
+            "table1",
+            "--duration",
+            "0.5",
+            "--snr-db",
+            "40",
+            "--seed",
+            "5",
+            "--out",
+            &rec,
+            "-q",
+        ]);
+        for method in ["algebraic", "modulating", "refine"] {
+            let est = p(&format!("e_{ext}_{method}.csv"));
+            let sum = p(&format!("s_{ext}_{method}.json"));
+            run(&[
+                "identify",
+                &rec,
+                "--scenario",
+                "table1",
+                "--method",
+                method,
+                "--out",
+                &est,
+                "--summary",
+                &sum,
+                "-q",
+            ]);
+            let mut s = summary(Path::new(&sum));
+            s["input"] = Value::Null;
+            results.push((ext, method, std::fs::read(&est).unwrap(), s));
+        }
+    }
+    for (ext, method, est, s) in &results[3..] {
+        let (_, _, e0, s0) = results
+            .iter()
+            .find(|r| r.0 == "csv" && r.1 == *method)
+            .unwrap();
+        assert!(
+            est == e0,
+            "{ext} {method}: the estimates differ from the CSV's"
+        );
+        assert_eq!(s, s0, "{ext} {method}: the summary differs from the CSV's");
+    }
+}
+
+#[test]
+fn columns_pick_channels_by_other_names_and_inspect_lists_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("r.csv");
+    let s = crate::common::simulate(&["--scenario", "table1", "--duration", "0.2"]);
+    // the same record with other column names and x, z in micrometres
+    let mut text = String::from("time [s],probe x [um],probe z [um]\n");
+    for line in s.lines().skip(1) {
+        let f: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+        text.push_str(&format!("{:?},{:?},{:?}\n", f[0], f[1] * 1e6, f[2] * 1e6));
+    }
+    std::fs::write(&csv, text).unwrap();
+    let (listing, _) = run(&["inspect", csv.to_str().unwrap()]);
+    assert!(listing.contains("3 channels"), "{listing}");
+    assert!(
+        listing.contains("probe x") && listing.contains("um"),
+        "{listing}"
+    );
+    assert!(
+        listing.contains("10000.000000"),
+        "the sample rate: {listing}"
+    );
+    let est = dir.path().join("e.csv");
+    let (_, stderr) = run(&[
+        "identify",
+        csv.to_str().unwrap(),
+        "--scenario",
+        "table1",
+        "--method",
+        "modulating",
+        "--columns",
+        "time,probe x,probe z",
+        "--out",
+        est.to_str().unwrap(),
+    ]);
+    assert!(stderr.contains("converted to m"), "{stderr}");
+    assert!(stderr.contains("error"), "{stderr}");
+    // a channel that is not there is named with what the file has
+    let out = rotorid()
+        .args([
+            "identify",
+            csv.to_str().unwrap(),
+            "--scenario",
+            "table1",
+            "--columns",
+        ])
+        .args(["t,x,z", "--out", est.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("no channel \"x\" for x; the file has: time, probe x, probe z"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_raw_acquisition_is_conditioned_and_identified() {
+    let dir = tempfile::tempdir().unwrap();
+    let rig = dir.path().join("rig.toml");
+    std::fs::copy(data("rig.toml"), &rig).unwrap();
+    let raw = dir.path().join("rig_raw.csv");
+    let slow = dir.path().join("rig_slowroll.csv");
+    run(&[
+        "simulate",
+        "--scenario",
+        rig.to_str().unwrap(),
+        "--raw",
+        "--out",
+        raw.to_str().unwrap(),
+        "--slow-roll-out",
+        slow.to_str().unwrap(),
+        "-q",
+    ]);
+    let header = std::fs::read_to_string(&raw).unwrap();
+    assert!(
+        header.starts_with("t,probe_L,probe_R,kp\n"),
+        "{}",
+        &header[..40]
+    );
+    // conditioned: a response CSV, x and z of micrometres
+    let resp = dir.path().join("resp.csv");
+    run(&[
+        "condition",
+        raw.to_str().unwrap(),
+        "--scenario",
+        rig.to_str().unwrap(),
+        "--out",
+        resp.to_str().unwrap(),
+    ]);
+    let text = std::fs::read_to_string(&resp).unwrap();
+    assert!(text.starts_with("t,x,z,phi,phi_dot,phi_ddot\n"));
+    let peak = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse::<f64>().unwrap().abs())
+        .fold(0.0, f64::max);
+    assert!((5e-6..3e-5).contains(&peak), "peak x {peak:e} m");
+    // identified from the raw record directly: within 4 standard errors of the truth
+    let sum = dir.path().join("s.json");
+    run(&[
+        "identify",
+        raw.to_str().unwrap(),
+        "--scenario",
+        rig.to_str().unwrap(),
+        "--method",
+        "refine",
+        "--out",
+        dir.path().join("e.csv").to_str().unwrap(),
+        "--summary",
+        sum.to_str().unwrap(),
+        "-q",
+    ]);
+    let s = summary(&sum);
+    assert!(
+        s["diagnostics"].as_array().unwrap().is_empty(),
+        "{}",
+        s["diagnostics"]
+    );
+    for p in s["parameters"].as_array().unwrap() {
+        let (v, t, e) = (
+            p["value"].as_f64().unwrap(),
+            p["truth"].as_f64().unwrap(),
+            p["std_error"].as_f64().unwrap(),
+        );
+        assert!(
+            (v - t).abs() < 4.0 * e,
+            "{}: {v} vs {t} +- {e}",
+            p["parameter"]
+        );
+    }
+}
