@@ -28,6 +28,12 @@ pub enum Error {
     /// the file, the line and the column (`io_kind` is set for a failed read).
     #[error(transparent)]
     Csv(#[from] rotorid_io::csv::CsvError),
+    /// A binary file (MAT, TDMS, UFF58, NPY/NPZ, Parquet) that cannot be read.
+    #[error(transparent)]
+    Read(#[from] rotorid_io::ReadError),
+    /// A channel that cannot play its role (missing, ambiguous, wrong unit or length).
+    #[error(transparent)]
+    Select(#[from] rotorid_io::SelectError),
     /// A file that cannot be read.
     #[error("cannot read {path}: {source}")]
     Io {

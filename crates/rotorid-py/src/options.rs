@@ -35,6 +35,8 @@ pub struct Options {
     pub tol: Option<f64>,
     /// modulating and refine: window of the modulating identifier \[s\] (> 0).
     pub window: Option<f64>,
+    /// algebraic: restart period of the overlapping windows \[s\] (> 0, at least 4 dt).
+    pub restart: Option<f64>,
 }
 
 /// The method called `name` (one of [`METHOD_NAMES`]).
@@ -66,6 +68,7 @@ pub fn method(name: &str, o: &Options) -> Result<Method, Error> {
         Ok(())
     };
     only("tol", o.tol.is_some(), &[Algebraic])?;
+    only("restart", o.restart.is_some(), &[Algebraic])?;
     only("quadrature", o.quadrature.is_some(), &[Algebraic, Refine])?;
     only("window", o.window.is_some(), &[Modulating, Refine])?;
     only("unknowns", o.unknowns.is_some(), &[Refine])?;
@@ -87,6 +90,15 @@ pub fn method(name: &str, o: &Options) -> Result<Method, Error> {
             )));
         }
         algebraic.tol = tol;
+    }
+    if let Some(p) = o.restart {
+        if !(p.is_finite() && p > 0.0) {
+            return Err(Error::invalid(format!(
+                "restart = {p} is out of range: must be finite and > 0 (s; at least 4 sampling \
+                 periods)"
+            )));
+        }
+        algebraic.restart_s = Some(p);
     }
     let window_s = o.window.unwrap_or(DEFAULT_WINDOW_S);
     if !(window_s.is_finite() && window_s > 0.0) {

@@ -35,6 +35,7 @@ fn py_err(e: Error) -> PyErr {
             _ => PyOSError::new_err(text),
         },
         Error::Csv(c) if c.io_kind.is_some() => PyOSError::new_err(text),
+        Error::Read(rotorid_io::ReadError::Io { .. }) => PyOSError::new_err(text),
         _ => PyValueError::new_err(text),
     }
 }
@@ -325,16 +326,21 @@ fn simulate<'py>(
     Ok(d)
 }
 
-/// Read a response CSV: a dict of arrays t, x, z [, phi, phi_dot, phi_ddot] in SI, and a
-/// dict of the columns the file gave in other units (name -> unit as given, e.g.
-/// `{"x": "um"}`), whose values were converted.
+/// Read a record: a dict of arrays t, x, z [, phi, phi_dot, phi_ddot] in SI, and a dict
+/// of the channels the file gave in other units (role -> unit as given, e.g. `{"x": "um"}`),
+/// whose values were converted. CSV is streamed by the command's reader; MAT, TDMS, UFF58,
+/// NPY/NPZ and Parquet (or a CSV with `columns`) go through `rotorid_io::select`.
 #[pyfunction]
+#[pyo3(signature = (path, columns=None))]
 fn read(
     py: Python<'_>,
     path: std::path::PathBuf,
+    columns: Option<String>,
 ) -> PyResult<(Bound<'_, PyDict>, Bound<'_, PyDict>)> {
     let path = path.to_string_lossy().into_owned();
-    let r = py.detach(|| crate::response::read(&path)).map_err(py_err)?;
+    let r = py
+        .detach(|| crate::response::read_any(&path, columns.as_deref()))
+        .map_err(py_err)?;
     let d = PyDict::new(py);
     d.set_item("t", PyArray1::from_vec(py, r.t))?;
     d.set_item("x", PyArray1::from_vec(py, r.x))?;
@@ -358,6 +364,7 @@ fn options_of(
     rcond_min: Option<f64>,
     tol: Option<f64>,
     window: Option<f64>,
+    restart: Option<f64>,
 ) -> Options {
     Options {
         unknowns,
@@ -365,6 +372,7 @@ fn options_of(
         rcond_min,
         tol,
         window,
+        restart,
     }
 }
 
@@ -372,7 +380,7 @@ fn options_of(
 #[pyfunction]
 #[pyo3(signature = (scenario, method, t, x, z, phi=None, phi_dot=None, phi_ddot=None, *,
     unknowns=None, quadrature=None, rcond_min=None, tol=None, window=None,
-    time_tolerance=DEFAULT_TIME_TOLERANCE, input=None, scenario_name=None))]
+    restart=None, time_tolerance=DEFAULT_TIME_TOLERANCE, input=None, scenario_name=None))]
 #[allow(clippy::too_many_arguments)]
 fn identify<'py>(
     py: Python<'py>,
@@ -389,11 +397,12 @@ fn identify<'py>(
     rcond_min: Option<f64>,
     tol: Option<f64>,
     window: Option<f64>,
+    restart: Option<f64>,
     time_tolerance: f64,
     input: Option<String>,
     scenario_name: Option<String>,
 ) -> PyResult<(String, Bound<'py, PyDict>, f64)> {
-    let o = options_of(unknowns, quadrature, rcond_min, tol, window);
+    let o = options_of(unknowns, quadrature, rcond_min, tol, window, restart);
     let method = options::method(method, &o).map_err(py_err)?;
     let held = Held::new(Some(t), x, z, [phi, phi_dot, phi_ddot])?;
     let columns = held.columns()?;
@@ -431,7 +440,7 @@ impl PySession {
 impl PySession {
     #[new]
     #[pyo3(signature = (scenario, method="algebraic", dt=None, t0=0.0, *, unknowns=None,
-        quadrature=None, rcond_min=None, tol=None, window=None,
+        quadrature=None, rcond_min=None, tol=None, window=None, restart=None,
         time_tolerance=DEFAULT_TIME_TOLERANCE))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -444,9 +453,10 @@ impl PySession {
         rcond_min: Option<f64>,
         tol: Option<f64>,
         window: Option<f64>,
+        restart: Option<f64>,
         time_tolerance: f64,
     ) -> PyResult<Self> {
-        let o = options_of(unknowns, quadrature, rcond_min, tol, window);
+        let o = options_of(unknowns, quadrature, rcond_min, tol, window, restart);
         let method = options::method(method, &o).map_err(py_err)?;
         let grid = dt.map(|dt| (t0, dt));
         let s = Stream::new(&scenario.inner, &method, grid, time_tolerance).map_err(py_err)?;

@@ -36,6 +36,36 @@ pub fn read(path: &str) -> Result<Response, Error> {
     parse(path, file)
 }
 
+/// Read the record at `path` in any format `rotorid_io` reads: a CSV without `columns`
+/// streamed as [`read`] does; otherwise the whole file as a table whose channels for t, x,
+/// z (and phi, phi_dot, phi_ddot) `columns` names (`"t,x,z"` or six names; default the
+/// role names), converted to SI from the units the file gives.
+pub fn read_any(path: &str, columns: Option<&str>) -> Result<Response, Error> {
+    // any other extension is read as the response CSV, as before
+    let format = rotorid_io::Format::from_path(std::path::Path::new(path)).ok();
+    if matches!(format, None | Some(rotorid_io::Format::Csv)) && columns.is_none() {
+        return read(path);
+    }
+    let table = rotorid_io::read_table(path)?;
+    let map = match columns {
+        Some(spec) => rotorid_io::ColumnMap::parse(spec)?,
+        None => rotorid_io::ColumnMap::default(),
+    };
+    let s = rotorid_io::select(&table, &map)?;
+    Ok(Response {
+        converted: s
+            .used
+            .iter()
+            .filter(|u| !u.conversion.is_identity())
+            .map(|u| (u.role.to_owned(), u.conversion.unit.to_owned()))
+            .collect(),
+        t: s.t,
+        x: s.x,
+        z: s.z,
+        speed: s.speed,
+    })
+}
+
 /// Read a response CSV from `input`; `file` names it in messages.
 pub fn parse<R: Read>(file: &str, input: R) -> Result<Response, Error> {
     let mut reader = ResponseReader::new(file, input)?;

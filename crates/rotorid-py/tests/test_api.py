@@ -78,3 +78,33 @@ def test_warnings_are_the_diagnostics(table1):
                              d=0.15, alpha_deg=45.0, rpm=1200.0, dt=1e-4, duration=0.1)
     res = rotorid.identify(rotorid.simulate(still, snr_db=40, seed=1), still, method="refine")
     assert res.warnings and res.warnings == [d["message"] for d in res.to_dict()["diagnostics"]]
+
+
+def test_read_takes_every_format_the_cli_takes(tmp_path, cli):
+    """A record written as Parquet, MAT and NPZ by the CLI reads back as the CSV does, and
+    `columns` picks channels by other names."""
+    import subprocess
+
+    csv = tmp_path / "r.csv"
+    subprocess.run([cli, "simulate", "--scenario", "table1", "--duration", "0.05", "--out", str(csv)], check=True)
+    ref = rotorid.read(csv)
+    for ext in ("parquet", "mat", "npz"):
+        p = tmp_path / f"r.{ext}"
+        subprocess.run([cli, "simulate", "--scenario", "table1", "--duration", "0.05", "--out", str(p)], check=True)
+        df = rotorid.read(p)
+        assert_frame_equal(df, ref, check_exact=True)
+    np.savez(tmp_path / "other.npz", time=ref["t"].to_numpy(), xx=ref["x"].to_numpy() * 1e6, zz=ref["z"].to_numpy())
+    df = rotorid.read(tmp_path / "other.npz", columns="time,xx,zz")
+    assert np.array_equal(df["x"].to_numpy(), ref["x"].to_numpy() * 1e6)
+    with pytest.raises(ValueError, match="no channel"):
+        rotorid.read(tmp_path / "other.npz")
+
+
+def test_restart_gives_windows_and_is_refused_for_other_methods():
+    sc = rotorid.Scenario.table1()
+    df = rotorid.simulate(sc, duration=0.2)
+    res = rotorid.identify(df, sc, method="algebraic", restart=0.05)
+    d = res.to_dict()["algebraic"]
+    assert d["restart_s"] == 0.05 and d["windows"] == 9
+    with pytest.raises(ValueError, match="restart applies to method algebraic only"):
+        rotorid.identify(df, sc, method="modulating", restart=0.05)

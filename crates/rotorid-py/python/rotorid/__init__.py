@@ -98,8 +98,13 @@ def simulate(
     return _frame(cols)
 
 
-def read(path: str | os.PathLike[str]) -> pd.DataFrame:
-    """Read a response CSV as ``rotorid identify`` reads it.
+def read(path: str | os.PathLike[str], columns: str | None = None) -> pd.DataFrame:
+    """Read a record as ``rotorid identify`` reads it: a response CSV, or a MATLAB .mat
+    (v5 or v7.3), LabVIEW .tdms, UFF58 (.uff, .unv, .58), .npy, .npz or .parquet file,
+    whose channels for t, x, z (and phi, phi_dot, phi_ddot) are the role names or those
+    ``columns`` gives (``"rec.t,rec.x,rec.z"``, ``"g/x"``, ``"0,1,2"`` for a 2-D .npy; a
+    struct field or TDMS channel alone when unique), with units from the file (TDMS
+    ``unit_string``, UFF58 ordinate unit), as ``rotorid identify --columns`` reads them.
 
     The header names at least t, x, z (any order, extra columns ignored); phi, phi_dot,
     phi_ddot all three or none. Values are SI unless a column's header gives its unit
@@ -120,7 +125,7 @@ def read(path: str | os.PathLike[str]) -> pd.DataFrame:
             of the column's quantity (listing the units it takes). OSError: the file
             cannot be read.
     """
-    columns, units = _rotorid.read(os.fspath(path))
+    columns, units = _rotorid.read(os.fspath(path), columns)
     df = _frame(columns)
     df.attrs["units"] = dict(units)
     return df
@@ -158,6 +163,7 @@ def identify(
     rcond_min: float | None = None,
     tol: float | None = None,
     window: float | None = None,
+    restart: float | None = None,
     time_tolerance: float = 1e-6,
     input: str | None = None,
     scenario: str | None = None,
@@ -180,6 +186,9 @@ def identify(
         quadrature: algebraic (and refine's start): trapezoid, am3, am4, am5 (default am5).
         rcond_min: conditioning threshold in [0, 1] (default 1e-5 algebraic, 1e-8 modulating).
         tol: algebraic: relative band of the identification time (default 0.01).
+        restart: algebraic: restart the integrals on overlapping windows of this period [s]
+            (every estimate from a window between half and one period old; default: one
+            identifier over the whole record).
         window: modulating and refine: window of the modulating identifier [s] (default 0.02).
         time_tolerance: allowed deviation of a stamp from the uniform grid, relative to dt.
         input, scenario: the names written into the summary (``to_dict()``), as the CLI
@@ -199,7 +208,7 @@ def identify(
         cols["phi"], cols["phi_dot"], cols["phi_ddot"],
         unknowns=None if unknowns is None else list(unknowns),
         quadrature=quadrature, rcond_min=rcond_min, tol=tol, window=window,
-        time_tolerance=time_tolerance, input=input, scenario_name=scenario,
+        restart=restart, time_tolerance=time_tolerance, input=input, scenario_name=scenario,
     )
     return Identification(summary, estimates, core_seconds=seconds)
 
@@ -236,13 +245,14 @@ class Session:
         rcond_min: float | None = None,
         tol: float | None = None,
         window: float | None = None,
+        restart: float | None = None,
         time_tolerance: float = 1e-6,
     ) -> None:
         self._inner = _rotorid.Session(
             _scenario(sc), method, dt, t0,
             unknowns=None if unknowns is None else list(unknowns),
             quadrature=quadrature, rcond_min=rcond_min, tol=tol, window=window,
-            time_tolerance=time_tolerance,
+            restart=restart, time_tolerance=time_tolerance,
         )
         self._chunks: list[dict[str, np.ndarray]] = []
 

@@ -25,7 +25,7 @@ def simulate(
     vx0: float | None = None,
     vz0: float | None = None,
 ) -> dict[str, np.ndarray]: ...
-def read(path: str) -> tuple[dict[str, np.ndarray], dict[str, str]]: ...
+def read(path: str, columns: str | None = None) -> tuple[dict[str, np.ndarray], dict[str, str]]: ...
 def identify(
     scenario: Scenario,
     method: str,
@@ -41,6 +41,7 @@ def identify(
     rcond_min: float | None = None,
     tol: float | None = None,
     window: float | None = None,
+    restart: float | None = None,
     time_tolerance: float = ...,
     input: str | None = None,
     scenario_name: str | None = None,
@@ -61,6 +62,7 @@ class Session:
         rcond_min: float | None = None,
         tol: float | None = None,
         window: float | None = None,
+        restart: float | None = None,
         time_tolerance: float = ...,
     ) -> Session: ...
     @property
