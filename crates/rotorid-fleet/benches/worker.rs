@@ -45,7 +45,11 @@ fn main() {
         std::hint::black_box(Frame::decode(&bytes).unwrap());
     }
     let decode = t.elapsed().as_secs_f64() / reps as f64;
-    println!("frame: {} bytes, decode {:.3} ms", bytes.len(), 1e3 * decode);
+    println!(
+        "frame: {} bytes, decode {:.3} ms",
+        bytes.len(),
+        1e3 * decode
+    );
 
     for (name, method, count) in [
         ("modulating", Method::modulating(), n),

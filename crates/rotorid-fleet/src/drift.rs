@@ -195,8 +195,7 @@ impl DriftState {
                 continue;
             };
             for (e, z) in &t.z {
-                let Some((_, pz)) = prev.z.iter().find(|(p, _)| p.parameter == e.parameter)
-                else {
+                let Some((_, pz)) = prev.z.iter().find(|(p, _)| p.parameter == e.parameter) else {
                     continue;
                 };
                 let over = |z: f64| z.abs() > s.z_threshold;

@@ -129,7 +129,12 @@ impl Fleet {
     /// Publish `payload` on `subject` with `Nats-Msg-Id` `id` and wait for JetStream's
     /// acknowledgement, retrying (same id: the server drops a copy it already has) for up
     /// to [`PUBLISH_RETRY_FOR`]. Returns whether the server had it already.
-    pub async fn publish(&self, subject: &str, id: &str, payload: Bytes) -> Result<bool, FleetError> {
+    pub async fn publish(
+        &self,
+        subject: &str,
+        id: &str,
+        payload: Bytes,
+    ) -> Result<bool, FleetError> {
         let ack = retry(&format!("publish {subject} ({id})"), || async {
             let p = jetstream::context::Publish::build()
                 .payload(payload.clone())

@@ -70,7 +70,11 @@ async fn counts(
         .info_with_subjects(filter)
         .await
         .map_err(|e| FleetError::nats(&op, e))?;
-    while let Some((subject, n)) = info.try_next().await.map_err(|e| FleetError::nats(&op, e))? {
+    while let Some((subject, n)) = info
+        .try_next()
+        .await
+        .map_err(|e| FleetError::nats(&op, e))?
+    {
         if let Some(id) = subject.strip_prefix(prefix) {
             out.insert(id.to_owned(), n as u64);
         }
@@ -160,7 +164,12 @@ pub fn render(s: &FleetStatus) -> String {
     );
     for m in &s.machines {
         let latest = m.latest.as_ref().map_or("-".to_owned(), |r| {
-            format!("window {} (t0 = {} s, {})", r.window, r.t0_s, r.identification.method.as_str())
+            format!(
+                "window {} (t0 = {} s, {})",
+                r.window,
+                r.t0_s,
+                r.identification.method.as_str()
+            )
         });
         let _ = writeln!(
             out,

@@ -17,8 +17,11 @@ use crate::error::FleetError;
 use crate::frame::{check_machine_id, Channel, Frame, MAX_SAMPLES};
 
 /// The speed channels: name and SI unit.
-pub const SPEED_CHANNELS: [(&str, &str); 3] =
-    [("phi", "rad"), ("phi_dot", "rad/s"), ("phi_ddot", "rad/s^2")];
+pub const SPEED_CHANNELS: [(&str, &str); 3] = [
+    ("phi", "rad"),
+    ("phi_dot", "rad/s"),
+    ("phi_ddot", "rad/s^2"),
+];
 
 /// Cut a recording (channels of equal length on the grid `t0 + i dt`) into windows of
 /// `window_samples` samples numbered from `first` (module doc).
@@ -36,7 +39,8 @@ pub fn windows(
         value,
         allowed: allowed.to_owned(),
     };
-    check_machine_id(machine).map_err(|e| input("machine id", machine.to_owned(), &e.to_string()))?;
+    check_machine_id(machine)
+        .map_err(|e| input("machine id", machine.to_owned(), &e.to_string()))?;
     if window_samples == 0 || window_samples > MAX_SAMPLES {
         return Err(input(
             "window samples",

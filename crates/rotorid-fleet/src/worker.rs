@@ -115,6 +115,9 @@ pub struct WorkerStats {
     pub errors: u64,
     /// Alerts published.
     pub alerts: u64,
+    /// Windows it got that had been delivered before (to a worker that died, or whose
+    /// acknowledgement was lost).
+    pub redelivered: u64,
 }
 
 /// What a machine's windows are identified with.
@@ -190,8 +193,7 @@ pub async fn prepare(fleet: &Fleet, cfg: &WorkerConfig) -> Result<PullConsumer, 
             return Err(FleetError::Scenario {
                 machine: "*".into(),
                 path: d.display().to_string(),
-                message: "not a directory (--scenarios DIR holds one <ID>.toml per machine)"
-                    .into(),
+                message: "not a directory (--scenarios DIR holds one <ID>.toml per machine)".into(),
             });
         }
     }
@@ -317,6 +319,7 @@ impl Worker<'_> {
                 return self.dead_letter(&msg, r).await;
             }
         };
+        self.stats.redelivered += u64::from(delivered > 1);
         if delivered > self.cfg.max_deliveries {
             let r = dead(
                 &frame.machine,

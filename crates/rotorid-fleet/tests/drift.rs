@@ -1,6 +1,7 @@
 //! Drift alerts with a real nats-server and two in-process workers: a machine whose kx drops
 //! by 5 % half-way alerts within two windows; 20 unchanged machines raise no alert over
 //! 10 s. Prints the largest |z| of the unchanged machines (the margin to a false alarm).
+//! Then `fleet status` agrees with the streams: every machine's windows, latest, alerts.
 
 mod common;
 
@@ -12,6 +13,7 @@ use rotorid::pipeline::Method;
 use rotorid_fleet::drift::DriftState;
 use rotorid_fleet::nats::Fleet;
 use rotorid_fleet::publish::{publish_frames, Rate};
+use rotorid_fleet::status::{render, status};
 use rotorid_fleet::window::windows;
 use rotorid_fleet::worker::{run, Scenarios, WorkerConfig};
 use rotorid_fleet::{AlertRecord, Channel, ALERT_STREAM, IDENT_STREAM};
@@ -82,7 +84,10 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
         if n as usize >= total {
             break;
         }
-        assert!(started.elapsed() < Duration::from_secs(240), "{n} of {total} results");
+        assert!(
+            started.elapsed() < Duration::from_secs(240),
+            "{n} of {total} results"
+        );
         tokio::time::sleep(Duration::from_millis(200)).await;
     }
     tx.send(true).unwrap();
@@ -124,7 +129,11 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
         "the kx drop (from window 5) is confirmed by window 6: {kx:?}"
     );
     let first = kx.iter().map(|a| a.window).min().unwrap();
-    let rel = kx.iter().find(|a| a.window == first).unwrap().relative_change;
+    let rel = kx
+        .iter()
+        .find(|a| a.window == first)
+        .unwrap()
+        .relative_change;
     assert!((rel + 0.05).abs() < 0.01, "kx change {rel}");
 
     // the margin: largest |z| and single exceedances of the unchanged machines
@@ -152,6 +161,38 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
         false_alarms.len(),
         100.0 * rel
     );
-    assert_eq!(tests, UNCHANGED * 7 * 6, "windows 3..9, six parameters each");
+    assert_eq!(
+        tests,
+        UNCHANGED * 7 * 6,
+        "windows 3..9, six parameters each"
+    );
     assert!(false_alarms.is_empty(), "false alarms: {false_alarms:?}");
+
+    // what `rotorid fleet status` shows
+    let st = status(&fleet, "drift").await.unwrap();
+    eprintln!("{}", render(&st));
+    assert_eq!(st.machines.len(), UNCHANGED + 1);
+    let c = st.consumer.as_ref().expect("the workers' consumer");
+    assert_eq!((c.pending, c.ack_pending), (0, 0));
+    for m in &st.machines {
+        assert_eq!(
+            (m.published, m.identified, m.errors),
+            (10, 10, 0),
+            "{}",
+            m.machine
+        );
+        assert_eq!(
+            m.latest.as_ref().map(|r| r.window),
+            Some(9),
+            "{}",
+            m.machine
+        );
+    }
+    let d = st.machines.iter().find(|m| m.machine == "drift").unwrap();
+    assert_eq!(d.alerts as usize, alerts.len());
+    assert_eq!(
+        d.last_alert.as_ref(),
+        alerts.last(),
+        "the last alert stored"
+    );
 }

@@ -46,8 +46,11 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
     let sims: Vec<_> = (0..MACHINES)
         .map(|i| {
             let s = scenario(rotor(i), SECONDS);
-            std::fs::write(scenarios.join(format!("{}.toml", machine(i))), scenario_toml(&s))
-                .unwrap();
+            std::fs::write(
+                scenarios.join(format!("{}.toml", machine(i))),
+                scenario_toml(&s),
+            )
+            .unwrap();
             let r = response(&s, 100 + i as u64);
             (s, r)
         })
@@ -126,15 +129,34 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
     tokio::time::sleep(Duration::from_secs(4)).await;
     let (sa, oa) = terminate(a);
     let (sb, ob) = terminate(b);
-    assert!(sa.success() && sb.success(), "workers exit 0 on SIGTERM: {sa} {sb}");
+    assert!(
+        sa.success() && sb.success(),
+        "workers exit 0 on SIGTERM: {sa} {sb}"
+    );
     eprintln!("worker a (restarted): {}worker b: {}", oa, ob);
+    // the killed worker held a window, or its pending pull got one: someone redid it
+    let redelivered: u64 = [&oa, &ob]
+        .iter()
+        .map(|o| {
+            o.split_whitespace()
+                .find_map(|w| w.strip_prefix("redelivered="))
+                .and_then(|n| n.parse::<u64>().ok())
+                .expect("the worker's closing line")
+        })
+        .sum();
+    assert!(
+        redelivered >= 1,
+        "no window was redelivered: the kill tested nothing"
+    );
 
     // every stored result, by (machine, window)
     let stream = fleet.js.get_stream(IDENT_STREAM).await.unwrap();
     let last = stream.get_info().await.unwrap().state.last_sequence;
     let mut got: BTreeMap<(String, u64), Vec<Vec<u8>>> = BTreeMap::new();
     for seq in 1..=last {
-        let Ok(m) = stream.direct_get(seq).await else { continue };
+        let Ok(m) = stream.direct_get(seq).await else {
+            continue;
+        };
         assert!(
             m.subject.starts_with("rotorid.ident."),
             "a window failed: {} {}",
@@ -179,13 +201,22 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
                 machine(i)
             );
             if w == WINDOWS - 1 {
-                let v = latest.get(machine(i)).await.unwrap().expect("a latest entry");
-                assert!(v == expected, "ROTORID_LATEST of {} is window {w}", machine(i));
+                let v = latest
+                    .get(machine(i))
+                    .await
+                    .unwrap()
+                    .expect("a latest entry");
+                assert!(
+                    v == expected,
+                    "ROTORID_LATEST of {} is window {w}",
+                    machine(i)
+                );
             }
         }
     }
     eprintln!(
-        "{} windows, each with exactly one result equal to offline identify; {:?} in all",
+        "{} windows, each with exactly one result equal to offline identify; {redelivered} \
+         redelivered; {:?} in all",
         got.len(),
         started.elapsed()
     );

@@ -4,7 +4,7 @@
 //! `rotorid-fleet-worker URL DURABLE METHOD SCENARIOS_DIR ACK_WAIT_S`
 //!
 //! METHOD is `algebraic`, `modulating` or `refine`; SCENARIOS_DIR holds `<ID>.toml`.
-//! Exits 0 after SIGINT/SIGTERM, printing `windows=N errors=N alerts=N`.
+//! Exits 0 after SIGINT/SIGTERM, printing `windows=N errors=N alerts=N redelivered=N`.
 
 use std::time::Duration;
 
@@ -51,7 +51,10 @@ fn main() {
         run(&fleet, &cfg, shutdown_signal()).await
     });
     match r {
-        Ok(s) => println!("windows={} errors={} alerts={}", s.windows, s.errors, s.alerts),
+        Ok(s) => println!(
+            "windows={} errors={} alerts={} redelivered={}",
+            s.windows, s.errors, s.alerts, s.redelivered
+        ),
         Err(e) => {
             eprintln!("Error: {e}");
             std::process::exit(1);

@@ -25,9 +25,8 @@ fn nats_server() -> PathBuf {
     if let Some(p) = std::env::var_os("NATS_SERVER") {
         return p.into();
     }
-    let on_path = std::env::var_os("PATH").is_some_and(|p| {
-        std::env::split_paths(&p).any(|d| d.join("nats-server").is_file())
-    });
+    let on_path = std::env::var_os("PATH")
+        .is_some_and(|p| std::env::split_paths(&p).any(|d| d.join("nats-server").is_file()));
     if on_path {
         "nats-server".into()
     } else {
@@ -68,7 +67,10 @@ impl Server {
         self.child = Some(child);
         let t = Instant::now();
         while TcpStream::connect(("127.0.0.1", self.port)).is_err() {
-            assert!(t.elapsed() < Duration::from_secs(20), "nats-server did not start");
+            assert!(
+                t.elapsed() < Duration::from_secs(20),
+                "nats-server did not start"
+            );
             std::thread::sleep(Duration::from_millis(50));
         }
     }
@@ -139,9 +141,21 @@ pub fn scenario_toml(s: &Scenario) -> String {
     )
 }
 
-/// The noisy response (40 dB SNR, seed `seed`).
+/// The noisy response (40 dB SNR, seed `seed`): duration / dt samples from t = 0 (the
+/// simulator's sample at t = duration is dropped: whole windows).
 pub fn response(s: &Scenario, seed: u64) -> TimeResponse {
     let mut r = simulate(s, Simulation::Exact).expect("simulates");
+    let n = (s.sampling.duration() / s.sampling.dt()).round() as usize;
+    for v in [
+        &mut r.t,
+        &mut r.x,
+        &mut r.z,
+        &mut r.phi,
+        &mut r.phi_dot,
+        &mut r.phi_ddot,
+    ] {
+        v.truncate(n);
+    }
     add_noise(&mut r, 40.0, seed).expect("noise");
     r
 }
