@@ -34,6 +34,9 @@ enum Command {
     Analyze(commands::analyze::AnalyzeArgs),
     /// Correction mass for single-plane balancing (identified unbalance or two runs).
     Balance(commands::balance::BalanceArgs),
+    Publish(commands::publish::PublishArgs),
+    Worker(commands::worker::WorkerArgs),
+    Fleet(commands::fleet::FleetArgs),
 }
 
 fn main() {
@@ -46,6 +49,9 @@ fn main() {
         Command::Plot(args) => commands::plot::run(args),
         Command::Analyze(args) => commands::analyze::run(args),
         Command::Balance(args) => commands::balance::run(args),
+        Command::Publish(args) => commands::publish::run(args),
+        Command::Worker(args) => commands::worker::run(args),
+        Command::Fleet(args) => commands::fleet::run(args),
     };
     if let Err(err) = result {
         eprintln!("Error: {err:#}");

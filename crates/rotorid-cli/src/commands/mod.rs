@@ -3,7 +3,10 @@
 pub mod analyze;
 pub mod balance;
 pub mod demo;
+pub mod fleet;
 pub mod identify;
 pub mod paper;
 pub mod plot;
+pub mod publish;
 pub mod simulate;
+pub mod worker;
