@@ -2,8 +2,10 @@
 //! [`Identification`] (worker).
 //!
 //! A recording of samples on the grid t0 + i dt is cut into windows of `n` samples: window
-//! k holds samples k n .. (k + 1) n (the last one may be shorter), its t0 is
-//! `t0 + (k n) as f64 * dt`, its number `first + k`.
+//! k holds samples k n .. (k + 1) n, its t0 is `t0 + (k n) as f64 * dt`, its number
+//! `first + k`. The last window holds what is left: a remainder shorter than n / 2 joins
+//! the window before (a 10 s simulation's 100 001st sample does not make a window of its
+//! own that no method can identify).
 //!
 //! Channels the worker reads: `x`, `z` \[m\] (required) and `phi` \[rad\], `phi_dot`
 //! \[rad/s\], `phi_ddot` \[rad/s^2\] (all three or none; without them the speed comes from
@@ -56,9 +58,18 @@ pub fn windows(
             &format!("{len} (the length of channel {})", channels[0].name),
         ));
     }
-    let frames = (0..len.div_ceil(window_samples))
+    let mut count = len.div_ceil(window_samples);
+    if count > 1 && len - (count - 1) * window_samples < window_samples.div_ceil(2) {
+        count -= 1;
+    }
+    let frames = (0..count)
         .map(|k| {
-            let (a, b) = (k * window_samples, ((k + 1) * window_samples).min(len));
+            let a = k * window_samples;
+            let b = if k + 1 == count {
+                len
+            } else {
+                a + window_samples
+            };
             let f = Frame {
                 machine: machine.to_owned(),
                 window: first + k as u64,
@@ -156,4 +167,82 @@ pub fn identify_frame(
         window: frame.window,
         source,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn channels(n: usize, names: &[(&str, &str)]) -> Vec<Channel> {
+        names
+            .iter()
+            .map(|(name, unit)| Channel {
+                name: (*name).into(),
+                unit: (*unit).into(),
+                data: (0..n).map(|i| i as f64).collect(),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn windows_cover_the_recording_once() {
+        let xz = [("x", "m"), ("z", "m")];
+        let lens = |len: usize| -> Vec<(usize, u64, f64, f64)> {
+            windows("m", 2.0, 0.5, &channels(len, &xz), 10, 7)
+                .unwrap()
+                .iter()
+                .map(|f| (f.samples(), f.window, f.t0, f.channels[1].data[0]))
+                .collect()
+        };
+        assert_eq!(lens(20), [(10, 7, 2.0, 0.0), (10, 8, 7.0, 10.0)]);
+        assert_eq!(lens(24), [(10, 7, 2.0, 0.0), (14, 8, 7.0, 10.0)]);
+        assert_eq!(
+            lens(25),
+            [(10, 7, 2.0, 0.0), (10, 8, 7.0, 10.0), (5, 9, 12.0, 20.0)]
+        );
+        assert_eq!(lens(3), [(3, 7, 2.0, 0.0)]);
+        assert!(lens(0).is_empty());
+        let e = windows("m", 0.0, 1.0, &channels(5, &xz), 0, 0).unwrap_err();
+        assert!(e.to_string().contains("window samples = 0"), "{e}");
+        let e = windows("a.b", 0.0, 1.0, &channels(5, &xz), 2, 0).unwrap_err();
+        assert!(e.to_string().contains("machine a.b"), "{e}");
+    }
+
+    fn frame(names: &[(&str, &str)]) -> Frame {
+        Frame {
+            machine: "m".into(),
+            window: 4,
+            t0: 4.0,
+            dt: 1e-4,
+            channels: channels(50, names),
+        }
+    }
+
+    #[test]
+    fn records_need_x_z_in_metres_and_all_or_no_speed_channels() {
+        let p = rotorid::SpeedProfile::constant_rpm(1200.0, 0.0).unwrap();
+        let ok = frame(&[("x", "m"), ("z", "m"), ("keyphasor", "V")]);
+        let r = record_of(&ok, Some(p)).unwrap();
+        assert_eq!((r.len(), r.grid().t0, r.grid().dt), (50, 4.0, 1e-4));
+        assert!(matches!(r.speed(), Speed::Profile(_)));
+        let all = [
+            ("x", "m"),
+            ("z", "m"),
+            ("phi", "rad"),
+            ("phi_dot", "rad/s"),
+            ("phi_ddot", "rad/s^2"),
+        ];
+        assert!(matches!(
+            record_of(&frame(&all), None).unwrap().speed(),
+            Speed::Samples { .. }
+        ));
+        let msg = |f: &Frame, p| record_of(f, p).unwrap_err().to_string();
+        assert!(msg(&frame(&[("x", "m")]), Some(p)).contains("channel z: missing"));
+        assert!(msg(&frame(&[("x", "mm"), ("z", "m")]), Some(p)).contains("unit \"mm\""));
+        assert!(msg(&frame(&all[..4]), Some(p)).contains("channel phi_ddot: missing"));
+        assert!(msg(&frame(&all[..2]), None).contains("channel phi: missing"));
+        let mut nan = ok.clone();
+        nan.channels[1].data[3] = f64::NAN;
+        assert!(msg(&nan, Some(p)).contains("machine m window 4"));
+    }
 }

@@ -54,12 +54,24 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
         let r = response(&s, 1000 + i as u64);
         all.push(windows(&id, 0.0, 1e-4, &probes(&r), WINDOW, 0).unwrap());
     }
-    let total: usize = all.iter().map(Vec::len).sum();
+    let total: usize = all.iter().map(Vec::len).sum::<usize>() + 2;
     for frames in &all {
         publish_frames(&fleet, frames, Rate::Max, |_| {})
             .await
             .unwrap();
     }
+
+    // two bad messages: bytes that are no frame, and a frame on another machine's subject
+    // (each must be dead-lettered with a record on rotorid.error.<ID>, never retried)
+    fleet
+        .publish("rotorid.raw.junk", "junk/0", "not a frame".into())
+        .await
+        .unwrap();
+    let misplaced = all[0][0].encode().unwrap();
+    fleet
+        .publish("rotorid.raw.other", "other/0", misplaced.into())
+        .await
+        .unwrap();
 
     let mut cfg = WorkerConfig::new(Method::modulating(), Scenarios::Dir(scenarios.clone()));
     cfg.durable = "drift".into();
@@ -91,13 +103,26 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
         tokio::time::sleep(Duration::from_millis(200)).await;
     }
     tx.send(true).unwrap();
-    let mut processed = 0;
+    let (mut processed, mut errors) = (0, 0);
     for w in workers {
         let s = w.await.unwrap().unwrap();
         processed += s.windows;
-        assert_eq!(s.errors, 0);
+        errors += s.errors;
     }
-    assert!(processed as usize >= total);
+    assert!(processed as usize >= total - 2);
+    assert_eq!(errors, 2, "the two bad messages, once each");
+    let ident = fleet.js.get_stream(IDENT_STREAM).await.unwrap();
+    for (id, needle) in [
+        ("junk", "not a rotorid frame: magic"),
+        ("other", "on rotorid.raw.other says it is machine drift's"),
+    ] {
+        let m = ident
+            .get_last_raw_message_by_subject(&format!("rotorid.error.{id}"))
+            .await
+            .unwrap();
+        let r: rotorid_fleet::ErrorRecord = serde_json::from_slice(&m.payload).unwrap();
+        assert!(r.error.contains(needle), "{}", r.error);
+    }
 
     // every alert
     let stream = fleet.js.get_stream(ALERT_STREAM).await.unwrap();
@@ -171,10 +196,14 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
     // what `rotorid fleet status` shows
     let st = status(&fleet, "drift").await.unwrap();
     eprintln!("{}", render(&st));
-    assert_eq!(st.machines.len(), UNCHANGED + 1);
+    assert_eq!(st.machines.len(), UNCHANGED + 3, "with junk and other");
     let c = st.consumer.as_ref().expect("the workers' consumer");
     assert_eq!((c.pending, c.ack_pending), (0, 0));
-    for m in &st.machines {
+    for m in st
+        .machines
+        .iter()
+        .filter(|m| m.machine != "junk" && m.machine != "other")
+    {
         assert_eq!(
             (m.published, m.identified, m.errors),
             (10, 10, 0),
