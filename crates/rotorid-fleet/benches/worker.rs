@@ -51,6 +51,43 @@ fn main() {
         1e3 * decode
     );
 
+    // the worker's round trips, one at a time as it does them
+    {
+        let server = Server::start(&tmp.path().join("js-rtt"));
+        let fleet = rt
+            .block_on(Fleet::connect(&server.url(), Duration::from_secs(10)))
+            .unwrap();
+        let ident = identify_frame(&base[0], &k, Some(s.speed), &Method::modulating()).unwrap();
+        let json = bytes::Bytes::from(serde_json::to_vec(&ident).unwrap());
+        let reps = 200;
+        let (publish, kv) = rt.block_on(async {
+            fleet.ident_stream().await.unwrap();
+            let t = Instant::now();
+            for i in 0..reps {
+                fleet
+                    .publish("rotorid.ident.rtt", &format!("rtt/{i}"), json.clone())
+                    .await
+                    .unwrap();
+            }
+            let publish = t.elapsed().as_secs_f64() / reps as f64;
+            let latest = fleet.latest().await.unwrap();
+            latest.put("rtt", json.clone()).await.unwrap();
+            let t = Instant::now();
+            for _ in 0..reps {
+                let e = latest.entry("rtt").await.unwrap().unwrap();
+                latest.update("rtt", json.clone(), e.revision).await.unwrap();
+            }
+            (publish, t.elapsed().as_secs_f64() / reps as f64)
+        });
+        println!(
+            "round trips: publish a result ({} bytes) and await its ack {:.2} ms; KV \
+             compare-and-set (entry + update) {:.2} ms",
+            json.len(),
+            1e3 * publish,
+            1e3 * kv
+        );
+    }
+
     for (name, method, count) in [
         ("modulating", Method::modulating(), n),
         ("refine", Method::refine(), (n / 3).max(3)),
