@@ -75,7 +75,10 @@ fn main() {
             let t = Instant::now();
             for _ in 0..reps {
                 let e = latest.entry("rtt").await.unwrap().unwrap();
-                latest.update("rtt", json.clone(), e.revision).await.unwrap();
+                latest
+                    .update("rtt", json.clone(), e.revision)
+                    .await
+                    .unwrap();
             }
             (publish, t.elapsed().as_secs_f64() / reps as f64)
         });
