@@ -98,8 +98,7 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
     // kill worker a in the middle of some window and start a new one
     wait_for(total / 4).await;
     let mut a = a;
-    a.kill().unwrap();
-    a.wait().unwrap();
+    a.kill();
     let a = spawn();
     eprintln!("worker killed and restarted at {:?}", started.elapsed());
     wait_for(total / 2).await;

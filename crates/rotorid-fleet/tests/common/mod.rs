@@ -176,9 +176,28 @@ pub fn probes(r: &TimeResponse) -> Vec<Channel> {
     ]
 }
 
+/// A worker process, SIGKILLed if the test ends (or panics) without [`terminate`].
+pub struct Worker(Option<Child>);
+
+impl Worker {
+    /// SIGKILL it now and reap it.
+    pub fn kill(&mut self) {
+        if let Some(mut c) = self.0.take() {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        self.kill();
+    }
+}
+
 /// The test worker binary as a child process.
-pub fn spawn_worker(url: &str, durable: &str, method: &str, dir: &Path, ack_wait_s: f64) -> Child {
-    Command::new(env!("CARGO_BIN_EXE_rotorid-fleet-worker"))
+pub fn spawn_worker(url: &str, durable: &str, method: &str, dir: &Path, ack_wait_s: f64) -> Worker {
+    let child = Command::new(env!("CARGO_BIN_EXE_rotorid-fleet-worker"))
         .arg(url)
         .arg(durable)
         .arg(method)
@@ -186,21 +205,20 @@ pub fn spawn_worker(url: &str, durable: &str, method: &str, dir: &Path, ack_wait
         .arg(ack_wait_s.to_string())
         .stdout(Stdio::piped())
         .spawn()
-        .expect("the worker starts")
+        .expect("the worker starts");
+    Worker(Some(child))
 }
 
-/// SIGTERM `child` and wait for it; returns its stdout.
-pub fn terminate(mut child: Child) -> (std::process::ExitStatus, String) {
+/// SIGTERM the worker and wait for it; returns its exit status and stdout.
+pub fn terminate(mut w: Worker) -> (std::process::ExitStatus, String) {
+    let mut child = w.0.take().expect("a running worker");
     unsafe {
         libc::kill(child.id() as i32, libc::SIGTERM);
     }
-    let out = {
+    let mut out = String::new();
+    if let Some(mut o) = child.stdout.take() {
         use std::io::Read as _;
-        let mut s = String::new();
-        if let Some(mut o) = child.stdout.take() {
-            let _ = o.read_to_string(&mut s);
-        }
-        s
-    };
+        let _ = o.read_to_string(&mut out);
+    }
     (child.wait().expect("the worker exits"), out)
 }
