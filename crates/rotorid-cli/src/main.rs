@@ -38,6 +38,9 @@ enum Command {
     Condition(commands::condition::ConditionArgs),
     /// List the channels of a record (CSV, MAT, TDMS, UFF58, NPY/NPZ, Parquet).
     Inspect(commands::inspect::InspectArgs),
+    Publish(commands::publish::PublishArgs),
+    Worker(commands::worker::WorkerArgs),
+    Fleet(commands::fleet::FleetArgs),
 }
 
 fn main() {
@@ -52,6 +55,9 @@ fn main() {
         Command::Balance(args) => commands::balance::run(args),
         Command::Condition(args) => commands::condition::run(args),
         Command::Inspect(args) => commands::inspect::run(args),
+        Command::Publish(args) => commands::publish::run(args),
+        Command::Worker(args) => commands::worker::run(args),
+        Command::Fleet(args) => commands::fleet::run(args),
     };
     if let Err(err) = result {
         eprintln!("Error: {err:#}");

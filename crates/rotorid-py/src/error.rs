@@ -30,10 +30,10 @@ pub enum Error {
     Csv(#[from] rotorid_io::csv::CsvError),
     /// A binary file (MAT, TDMS, UFF58, NPY/NPZ, Parquet) that cannot be read.
     #[error(transparent)]
-    Read(#[from] rotorid_io::ReadError),
+    Read(Box<rotorid_io::ReadError>),
     /// A channel that cannot play its role (missing, ambiguous, wrong unit or length).
     #[error(transparent)]
-    Select(#[from] rotorid_io::SelectError),
+    Select(Box<rotorid_io::SelectError>),
     /// A file that cannot be read.
     #[error("cannot read {path}: {source}")]
     Io {
@@ -42,6 +42,18 @@ pub enum Error {
         /// The operating system's error.
         source: std::io::Error,
     },
+}
+
+impl From<rotorid_io::ReadError> for Error {
+    fn from(e: rotorid_io::ReadError) -> Self {
+        Self::Read(Box::new(e))
+    }
+}
+
+impl From<rotorid_io::SelectError> for Error {
+    fn from(e: rotorid_io::SelectError) -> Self {
+        Self::Select(Box::new(e))
+    }
 }
 
 impl Error {

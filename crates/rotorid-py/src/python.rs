@@ -35,7 +35,9 @@ fn py_err(e: Error) -> PyErr {
             _ => PyOSError::new_err(text),
         },
         Error::Csv(c) if c.io_kind.is_some() => PyOSError::new_err(text),
-        Error::Read(rotorid_io::ReadError::Io { .. }) => PyOSError::new_err(text),
+        Error::Read(r) if matches!(*r, rotorid_io::ReadError::Io { .. }) => {
+            PyOSError::new_err(text)
+        }
         _ => PyValueError::new_err(text),
     }
 }

@@ -1,0 +1,173 @@
+//! `rotorid publish`: send a recording to NATS JetStream as windows (crates/rotorid-fleet,
+//! docs/fleet.md) for `rotorid worker` to identify.
+
+use std::time::Duration;
+
+use anyhow::Context as _;
+use rotorid::pipeline::{TimeGrid, DEFAULT_TIME_TOLERANCE};
+use rotorid_fleet::nats::Fleet;
+use rotorid_fleet::publish::{publish_frames, Rate};
+use rotorid_fleet::window::windows;
+use rotorid_fleet::Channel;
+
+use crate::io::{open_input, LoadScenario as _, ResponseReader, ScenarioSpec};
+
+/// Send a recording to NATS JetStream as windows on rotorid.raw.<ID> (stream ROTORID_RAW).
+#[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Example:\n  rotorid publish rig.csv --nats nats://127.0.0.1:4222 \
+                        --machine pump-7 --rate realtime"
+)]
+pub struct PublishArgs {
+    /// The recording: a response CSV t,x,z[,phi,phi_dot,phi_ddot] in SI (s, m, rad, rad/s,
+    /// rad/s^2), uniformly sampled.
+    pub file: String,
+    /// The NATS server.
+    #[arg(long, value_name = "URL")]
+    pub nats: String,
+    /// The machine's id: letters, digits, '_' and '-' (one NATS subject token).
+    #[arg(long, value_name = "ID")]
+    pub machine: String,
+    /// A scenario whose [speed] profile gives phi, phi_dot, phi_ddot channels when the
+    /// file has none (else the worker's scenario must have one).
+    #[arg(long, value_name = "S.toml")]
+    pub scenario: Option<String>,
+    /// realtime: each window when its last sample would have been measured; max: at once.
+    #[arg(long, value_enum, default_value = "max")]
+    pub rate: RateArg,
+    /// Window length [s].
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub window_s: f64,
+    /// Number of the first window (windows are numbered per machine, increasing with
+    /// time: continue a machine's numbering for its next recording).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub first_window: u64,
+}
+
+/// `--rate`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum RateArg {
+    /// At the recording's pace.
+    Realtime,
+    /// As fast as the server acknowledges.
+    Max,
+}
+
+/// The recording's channels and grid (the CSV glue; a reader of other formats gives the
+/// same named SI channels).
+fn read_recording(file: &str) -> anyhow::Result<(TimeGrid, Vec<Channel>)> {
+    // a response CSV is streamed by its reader; any other format (or a CSV with other
+    // column names) is read whole through rotorid-io, units converted to SI
+    let cols = if crate::io::tables::is_tabular(file, None) {
+        let table = crate::io::tables::read(file)?;
+        crate::io::tables::columns(&table, None)?
+    } else {
+        let (name, input) = open_input(file)?;
+        let mut reader = ResponseReader::new(&name, input)?;
+        let mut c = rotorid_io::SiColumns {
+            speed: reader.has_phi().then(Default::default),
+            ..Default::default()
+        };
+        while let Some(row) = reader.next_row()? {
+            c.t.push(row.t);
+            c.x.push(row.x);
+            c.z.push(row.z);
+            if let (Some(s), Some([p, w, a])) = (row.speed, c.speed.as_mut()) {
+                p.push(s.phi);
+                w.push(s.omega);
+                a.push(s.omega_dot);
+            }
+        }
+        c
+    };
+    let grid = TimeGrid::fit(&cols.t, DEFAULT_TIME_TOLERANCE)
+        .with_context(|| format!("{file}: column t"))?;
+    let mut channels = vec![("x", "m", cols.x), ("z", "m", cols.z)];
+    if let Some([phi, w, wd]) = cols.speed {
+        channels.extend([
+            ("phi", "rad", phi),
+            ("phi_dot", "rad/s", w),
+            ("phi_ddot", "rad/s^2", wd),
+        ]);
+    }
+    let channels = channels
+        .into_iter()
+        .map(|(n, u, data)| Channel {
+            name: n.into(),
+            unit: u.into(),
+            data,
+        })
+        .collect();
+    Ok((grid, channels))
+}
+
+/// Run `rotorid publish`.
+pub fn run(args: PublishArgs) -> anyhow::Result<()> {
+    if !(args.window_s.is_finite() && args.window_s > 0.0) {
+        anyhow::bail!(
+            "--window-s = {} is out of range: must be finite and > 0 (s)",
+            args.window_s
+        );
+    }
+    let (grid, mut channels) = read_recording(&args.file)?;
+    if channels.len() == 2 {
+        if let Some(s) = &args.scenario {
+            let spec = ScenarioSpec::load(s)?;
+            if let Some(p) = spec.identification()?.speed {
+                let n = channels[0].data.len();
+                let states: Vec<_> = (0..n).map(|i| p.at(grid.time(i))).collect();
+                for (name, unit, f) in [
+                    (
+                        "phi",
+                        "rad",
+                        (|s: &rotorid::SpeedState| s.phi) as fn(&_) -> f64,
+                    ),
+                    ("phi_dot", "rad/s", |s| s.omega),
+                    ("phi_ddot", "rad/s^2", |s| s.omega_dot),
+                ] {
+                    channels.push(Channel {
+                        name: name.into(),
+                        unit: unit.into(),
+                        data: states.iter().map(f).collect(),
+                    });
+                }
+            }
+        }
+    }
+    let n = (args.window_s / grid.dt).round();
+    if !(n >= 1.0 && n <= rotorid_fleet::frame::MAX_SAMPLES as f64) {
+        anyhow::bail!(
+            "--window-s = {} s is {n} samples of {} s: must be 1 ..= {} samples",
+            args.window_s,
+            grid.dt,
+            rotorid_fleet::frame::MAX_SAMPLES
+        );
+    }
+    let frames = windows(
+        &args.machine,
+        grid.t0,
+        grid.dt,
+        &channels,
+        n as usize,
+        args.first_window,
+    )?;
+    let rate = match args.rate {
+        RateArg::Realtime => Rate::Realtime,
+        RateArg::Max => Rate::Max,
+    };
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    let report = rt.block_on(async {
+        let fleet = Fleet::connect(&args.nats, Duration::from_secs(10)).await?;
+        publish_frames(&fleet, &frames, rate, |f| {
+            eprintln!("window {} (t0 = {} s) acknowledged", f.window, f.t0);
+        })
+        .await
+    })?;
+    eprintln!(
+        "{} windows of machine {} on rotorid.raw.{} ({} already stored), {} bytes",
+        report.windows, args.machine, args.machine, report.duplicates, report.bytes
+    );
+    Ok(())
+}

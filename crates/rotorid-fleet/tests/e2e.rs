@@ -1,0 +1,222 @@
+//! End to end with a real nats-server: 20 machines x 10 s of 10 kHz data, two worker
+//! processes; one is SIGKILLed mid-run and restarted, the server is SIGKILLed and
+//! restarted once. Afterwards every window of every machine has exactly one result in
+//! ROTORID_IDENT, byte for byte the JSON of an offline `identify` of the same samples
+//! (cut here from the simulation, not from the frames), and ROTORID_LATEST holds each
+//! machine's last window.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+use common::*;
+use rotorid::pipeline::{identify, Knowledge, Method, Record, Speed, TimeGrid};
+use rotorid_fleet::nats::Fleet;
+use rotorid_fleet::publish::{publish_frames, Rate};
+use rotorid_fleet::window::windows;
+use rotorid_fleet::{WindowResult, FLEET_SCHEMA, IDENT_STREAM};
+
+const MACHINES: usize = 20;
+const SECONDS: f64 = 10.0;
+const WINDOW: usize = 10_000; // 1 s at 10 kHz
+const WINDOWS: usize = 10;
+
+fn machine(i: usize) -> String {
+    format!("m{i:02}")
+}
+
+/// Messages in ROTORID_IDENT.
+async fn ident_count(fleet: &Fleet) -> u64 {
+    match fleet.js.get_stream(IDENT_STREAM).await {
+        Ok(mut s) => s.info().await.map(|i| i.state.messages).unwrap_or(0),
+        Err(_) => 0,
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
+    let tmp = tempfile::tempdir().unwrap();
+    let store = tmp.path().join("js");
+    let scenarios = tmp.path().join("scenarios");
+    std::fs::create_dir_all(&scenarios).unwrap();
+    let mut server = Server::start(&store);
+    let url = server.url();
+
+    let sims: Vec<_> = (0..MACHINES)
+        .map(|i| {
+            let s = scenario(rotor(i), SECONDS);
+            std::fs::write(
+                scenarios.join(format!("{}.toml", machine(i))),
+                scenario_toml(&s),
+            )
+            .unwrap();
+            let r = response(&s, 100 + i as u64);
+            (s, r)
+        })
+        .collect();
+
+    let method = "modulating";
+    let spawn = || spawn_worker(&url, "e2e", method, &scenarios, 3.0);
+    let a = spawn();
+    let b = spawn();
+
+    let fleet = Fleet::connect(&url, Duration::from_secs(10)).await.unwrap();
+    let mut tasks = Vec::new();
+    for (i, (_, r)) in sims.iter().enumerate() {
+        let frames = windows(&machine(i), r.t[0], 1e-4, &probes(r), WINDOW, 0).unwrap();
+        assert_eq!(frames.len(), WINDOWS);
+        let fleet = fleet.clone();
+        tasks.push(tokio::spawn(async move {
+            publish_frames(&fleet, &frames, Rate::Max, |_| {}).await
+        }));
+    }
+    for t in tasks {
+        let rep = t.await.unwrap().unwrap();
+        assert_eq!(rep.windows, WINDOWS as u64);
+    }
+
+    let total = (MACHINES * WINDOWS) as u64;
+    let started = Instant::now();
+    let wait_for = |n: u64| {
+        let fleet = fleet.clone();
+        async move {
+            loop {
+                let c = ident_count(&fleet).await;
+                if c >= n {
+                    return c;
+                }
+                assert!(
+                    started.elapsed() < Duration::from_secs(240),
+                    "only {c} of {n} results after {:?}",
+                    started.elapsed()
+                );
+                tokio::time::sleep(Duration::from_millis(100)).await;
+            }
+        }
+    };
+    // kill worker a in the middle of some window and start a new one
+    wait_for(total / 4).await;
+    let mut a = a;
+    a.kill();
+    let a = spawn();
+    eprintln!("worker killed and restarted at {:?}", started.elapsed());
+    wait_for(total / 2).await;
+    server.restart();
+    eprintln!("server restarted at {:?}", started.elapsed());
+    let fleet = Fleet::connect(&url, Duration::from_secs(10)).await.unwrap();
+    let wait_for = |n: u64| {
+        let fleet = fleet.clone();
+        async move {
+            loop {
+                let c = ident_count(&fleet).await;
+                if c >= n {
+                    return c;
+                }
+                assert!(
+                    started.elapsed() < Duration::from_secs(240),
+                    "only {c} of {n} results after {:?}",
+                    started.elapsed()
+                );
+                tokio::time::sleep(Duration::from_millis(100)).await;
+            }
+        }
+    };
+    wait_for(total).await;
+    eprintln!("all {total} results at {:?}", started.elapsed());
+    // a redelivered window may still be on its way: let the ack wait pass
+    tokio::time::sleep(Duration::from_secs(4)).await;
+    let (sa, oa) = terminate(a);
+    let (sb, ob) = terminate(b);
+    assert!(
+        sa.success() && sb.success(),
+        "workers exit 0 on SIGTERM: {sa} {sb}"
+    );
+    eprintln!("worker a (restarted): {}worker b: {}", oa, ob);
+    // the killed worker held a window, or its pending pull got one: someone redid it
+    let redelivered: u64 = [&oa, &ob]
+        .iter()
+        .map(|o| {
+            o.split_whitespace()
+                .find_map(|w| w.strip_prefix("redelivered="))
+                .and_then(|n| n.parse::<u64>().ok())
+                .expect("the worker's closing line")
+        })
+        .sum();
+    assert!(
+        redelivered >= 1,
+        "no window was redelivered: the kill tested nothing"
+    );
+
+    // every stored result, by (machine, window)
+    let stream = fleet.js.get_stream(IDENT_STREAM).await.unwrap();
+    let last = stream.get_info().await.unwrap().state.last_sequence;
+    let mut got: BTreeMap<(String, u64), Vec<Vec<u8>>> = BTreeMap::new();
+    for seq in 1..=last {
+        let Ok(m) = stream.direct_get(seq).await else {
+            continue;
+        };
+        assert!(
+            m.subject.starts_with("rotorid.ident."),
+            "a window failed: {} {}",
+            m.subject,
+            String::from_utf8_lossy(&m.payload)
+        );
+        let r: WindowResult = serde_json::from_slice(&m.payload).unwrap();
+        assert_eq!(m.subject.as_str(), format!("rotorid.ident.{}", r.machine));
+        got.entry((r.machine.clone(), r.window))
+            .or_default()
+            .push(m.payload.to_vec());
+    }
+    assert_eq!(got.len(), MACHINES * WINDOWS, "one entry per window");
+    let latest = fleet.latest().await.unwrap();
+    for (i, (s, r)) in sims.iter().enumerate() {
+        let k = Knowledge::from_scenario(s);
+        for w in 0..WINDOWS {
+            let stored = &got[&(machine(i), w as u64)];
+            assert_eq!(stored.len(), 1, "machine {} window {w}", machine(i));
+            let (a, b) = (w * WINDOW, (w + 1) * WINDOW);
+            let record = Record::uniform(
+                TimeGrid::given(r.t[a], 1e-4).unwrap(),
+                r.x[a..b].to_vec(),
+                r.z[a..b].to_vec(),
+                Speed::Profile(s.speed),
+            )
+            .unwrap();
+            let offline = identify(&record, &k, &Method::modulating()).unwrap();
+            let expected = WindowResult {
+                fleet_schema: FLEET_SCHEMA,
+                machine: machine(i),
+                window: w as u64,
+                t0_s: r.t[a],
+                dt_s: 1e-4,
+                samples: WINDOW as u64,
+                identification: offline,
+            };
+            let expected = serde_json::to_vec(&expected).unwrap();
+            assert!(
+                stored[0] == expected,
+                "machine {} window {w}: the stored result differs from offline identify",
+                machine(i)
+            );
+            if w == WINDOWS - 1 {
+                let v = latest
+                    .get(machine(i))
+                    .await
+                    .unwrap()
+                    .expect("a latest entry");
+                assert!(
+                    v == expected,
+                    "ROTORID_LATEST of {} is window {w}",
+                    machine(i)
+                );
+            }
+        }
+    }
+    eprintln!(
+        "{} windows, each with exactly one result equal to offline identify; {redelivered} \
+         redelivered; {:?} in all",
+        got.len(),
+        started.elapsed()
+    );
+}
