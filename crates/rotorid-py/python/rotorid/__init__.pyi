@@ -86,7 +86,7 @@ def simulate(
 ) -> pd.DataFrame:
     """t [s], x, z [m], phi [rad], phi_dot [rad/s], phi_ddot [rad/s^2]."""
 
-def read(path: str | os.PathLike[str]) -> pd.DataFrame:
+def read(path: str | os.PathLike[str], columns: str | None = None) -> pd.DataFrame:
     """A response CSV as the CLI reads it."""
 
 def identify(
@@ -99,6 +99,7 @@ def identify(
     rcond_min: float | None = None,
     tol: float | None = None,
     window: float | None = None,
+    restart: float | None = None,
     time_tolerance: float = 1e-6,
     input: str | None = None,
     scenario: str | None = None,
@@ -120,6 +121,7 @@ class Session:
         rcond_min: float | None = None,
         tol: float | None = None,
         window: float | None = None,
+        restart: float | None = None,
         time_tolerance: float = 1e-6,
     ) -> None: ...
     @property
