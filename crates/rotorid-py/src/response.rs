@@ -69,28 +69,19 @@ pub fn read_any(path: &str, columns: Option<&str>) -> Result<Response, Error> {
 /// Read a response CSV from `input`; `file` names it in messages.
 pub fn parse<R: Read>(file: &str, input: R) -> Result<Response, Error> {
     let mut reader = ResponseReader::new(file, input)?;
-    let mut r = Response {
-        converted: reader
-            .conversions()
-            .into_iter()
-            .map(|(name, c)| (name.to_owned(), c.unit.to_owned()))
-            .collect(),
-        speed: reader
-            .has_phi()
-            .then(|| [Vec::new(), Vec::new(), Vec::new()]),
-        ..Response::default()
-    };
-    while let Some(row) = reader.next_row()? {
-        r.t.push(row.t);
-        r.x.push(row.x);
-        r.z.push(row.z);
-        if let (Some(s), Some(speed)) = (row.speed, r.speed.as_mut()) {
-            speed[0].push(s.phi);
-            speed[1].push(s.phi_dot);
-            speed[2].push(s.phi_ddot);
-        }
-    }
-    Ok(r)
+    let converted = reader
+        .conversions()
+        .into_iter()
+        .map(|(name, c)| (name.to_owned(), c.unit.to_owned()))
+        .collect();
+    let c = reader.read_columns()?;
+    Ok(Response {
+        t: c.t,
+        x: c.x,
+        z: c.z,
+        speed: c.speed,
+        converted,
+    })
 }
 
 #[cfg(test)]

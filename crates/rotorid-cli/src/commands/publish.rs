@@ -10,7 +10,7 @@ use rotorid_fleet::publish::{publish_frames, Rate};
 use rotorid_fleet::window::windows;
 use rotorid_fleet::Channel;
 
-use crate::io::{open_input, LoadScenario as _, ResponseReader, ScenarioSpec};
+use crate::io::{open_input, LoadScenario as _, ScenarioSpec};
 
 /// Send a recording to NATS JetStream as windows on rotorid.raw.<ID> (stream ROTORID_RAW).
 #[derive(Debug, clap::Args)]
@@ -63,22 +63,7 @@ fn read_recording(file: &str) -> anyhow::Result<(TimeGrid, Vec<Channel>)> {
         crate::io::tables::columns(&table, None)?
     } else {
         let (name, input) = open_input(file)?;
-        let mut reader = ResponseReader::new(&name, input)?;
-        let mut c = rotorid_io::SiColumns {
-            speed: reader.has_phi().then(Default::default),
-            ..Default::default()
-        };
-        while let Some(row) = reader.next_row()? {
-            c.t.push(row.t);
-            c.x.push(row.x);
-            c.z.push(row.z);
-            if let (Some(s), Some([p, w, a])) = (row.speed, c.speed.as_mut()) {
-                p.push(s.phi);
-                w.push(s.omega);
-                a.push(s.omega_dot);
-            }
-        }
-        c
+        rotorid_io::csv::ResponseReader::new(&name, input)?.read_columns()?
     };
     let grid = TimeGrid::fit(&cols.t, DEFAULT_TIME_TOLERANCE)
         .with_context(|| format!("{file}: column t"))?;

@@ -231,20 +231,14 @@ fn write_any(path: &str, t: &rotorid_io::Table) -> anyhow::Result<()> {
     }
     let mut out = Output::create(path, FileMode::Atomic)?;
     let names: Vec<&str> = t.channels.iter().map(|c| c.name.as_str()).collect();
-    let mut text = Vec::with_capacity(64);
     use std::io::Write as _;
     writeln!(out, "{}", names.join(",")).with_context(|| format!("cannot write {path}"))?;
+    let (mut scratch, mut row) = (Vec::with_capacity(64), Vec::with_capacity(names.len()));
     let n = t.channels.first().map_or(0, |c| c.data.len());
     for i in 0..n {
-        text.clear();
-        for (j, c) in t.channels.iter().enumerate() {
-            if j > 0 {
-                text.push(b',');
-            }
-            crate::io::number::push_f64(&mut text, c.data[i]);
-        }
-        text.push(b'\n');
-        out.write_all(&text)
+        row.clear();
+        row.extend(t.channels.iter().map(|c| Some(c.data[i])));
+        crate::io::number::write_row(&mut out, &mut scratch, &row)
             .with_context(|| format!("cannot write {path}"))?;
     }
     out.commit()

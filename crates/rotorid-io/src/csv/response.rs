@@ -170,6 +170,26 @@ impl<R: Read> ResponseReader<R> {
         &self.file
     }
 
+    /// Every remaining row, as columns in SI (the reader's conversions are in
+    /// [`Self::conversions`]; `used` is left empty).
+    pub fn read_columns(&mut self) -> Result<crate::SiColumns, CsvError> {
+        let mut c = crate::SiColumns {
+            speed: self.has_phi().then(Default::default),
+            ..Default::default()
+        };
+        while let Some(row) = self.next_row()? {
+            c.t.push(row.t);
+            c.x.push(row.x);
+            c.z.push(row.z);
+            if let (Some(s), Some([p, w, a])) = (row.speed, c.speed.as_mut()) {
+                p.push(s.phi);
+                w.push(s.phi_dot);
+                a.push(s.phi_ddot);
+            }
+        }
+        Ok(c)
+    }
+
     /// True when the file has the phi, phi_dot, phi_ddot columns.
     pub fn has_phi(&self) -> bool {
         self.phi.is_some()

@@ -240,17 +240,31 @@ fn read_all<R: Read>(
             z: row.z,
             speed: row.speed,
         };
-        let mut st = state.borrow_mut();
-        st.push(&s).map_err(|e| {
-            let hint = match e {
-                PipelineError::NonUniformSampling { .. } => " (--time-tolerance)",
-                _ => "",
-            };
-            CsvError::line(io.name, row.line, format!("{e}{hint}"))
+        push(io, state, &s, |m| {
+            CsvError::line(io.name, row.line, m).into()
         })?;
-        if let Some(e) = st.rows.error.take() {
-            return Err(e).with_context(|| format!("cannot write {}", io.out_name));
-        }
+    }
+    Ok(())
+}
+
+/// One sample into the session; `at` locates a refused sample's message (its line or
+/// index). A failed write of an estimate row is reported too.
+fn push(
+    io: &Io,
+    state: &Rc<RefCell<State>>,
+    s: &Sample,
+    at: impl FnOnce(String) -> anyhow::Error,
+) -> anyhow::Result<()> {
+    let mut st = state.borrow_mut();
+    st.push(s).map_err(|e| {
+        let hint = match e {
+            PipelineError::NonUniformSampling { .. } => " (--time-tolerance)",
+            _ => "",
+        };
+        at(format!("{e}{hint}"))
+    })?;
+    if let Some(e) = st.rows.error.take() {
+        return Err(e).with_context(|| format!("cannot write {}", io.out_name));
     }
     Ok(())
 }
@@ -281,17 +295,9 @@ fn push_columns(
                 omega_dot: a[i],
             }),
         };
-        let mut st = state.borrow_mut();
-        st.push(&s).map_err(|e| {
-            let hint = match e {
-                PipelineError::NonUniformSampling { .. } => " (--time-tolerance)",
-                _ => "",
-            };
-            anyhow::anyhow!("{}, sample {i} (t = {} s): {e}{hint}", io.name, cols.t[i])
+        push(io, state, &s, |m| {
+            anyhow::anyhow!("{}, sample {i} (t = {} s): {m}", io.name, cols.t[i])
         })?;
-        if let Some(e) = st.rows.error.take() {
-            return Err(e).with_context(|| format!("cannot write {}", io.out_name));
-        }
     }
     Ok(())
 }
