@@ -1,5 +1,6 @@
-//! `rotorid plot INPUT.csv --out FILE.png|FILE.svg [--scenario table1|FILE.toml]
-//! [--from S --to S]`: draw a CSV written by `rotorid simulate` or `rotorid identify`.
+//! `rotorid plot INPUT --out FILE.png|FILE.svg [--scenario table1|FILE.toml]
+//! [--from S --to S]`: draw a CSV written by `rotorid simulate`, `rotorid condition` or
+//! `rotorid identify`, any record `rotorid identify` reads, or a raw acquisition.
 //!
 //! The kind is chosen from the header (names compared as the readers in [`crate::io`]
 //! compare them: trimmed, lower-case, a unit suffix `[m]` or `(m)` split off; a response's
@@ -13,7 +14,15 @@
 //!   of the window's estimates.
 //! - otherwise `t` with `x` or `z`: simulate output (`t,x,z[,phi,phi_dot,phi_ddot]`) ->
 //!   x(t) and z(t), and the orbit z against x (equal scales), side by side; displacements
-//!   in the SI prefix that suits their size (nm, um, ...).
+//!   in the SI prefix that suits their size (nm, um, ...). When the file has `phi`, the
+//!   orbit carries the keyphasor dots (the convention engineers read: the shaft's position
+//!   at each once-per-turn event): black dots where phi passes the keyphasor angle, which
+//!   is `[acquisition.keyphasor] angle_deg` of `--scenario`, else 0 (mod 2 pi), the
+//!   position interpolated linearly between the two samples around the crossing.
+//! - a raw record (probe volts and keyphasor) with `--scenario` holding `[acquisition]`:
+//!   conditioned first as `rotorid condition` does (any format `rotorid_io` reads; its
+//!   notes and warnings printed), then drawn as a response with keyphasor dots. Any other
+//!   non-CSV file is read whole and its t, x, z[, phi] channels drawn.
 //!
 //! `--from`/`--to` restrict the time window [s]. The files are read with the validating
 //! readers of [`crate::io`] (line and column in every error), streaming: every curve is
@@ -30,6 +39,7 @@ use crate::io::columns::{csv_reader, io_error, next_record, normalise};
 use crate::io::csv_error::abbreviate;
 use crate::io::lines::LineReader;
 use crate::io::number::readable;
+use crate::io::tables;
 use crate::io::LoadScenario as _;
 use crate::io::{
     check_distinct_files, open_input, EstimatesReader, ResponseReader, ScenarioSpec, Truth,
@@ -52,18 +62,27 @@ const ORBIT_SEGMENTS: usize = 200_000;
 /// Values kept for the late median of an estimate (exact up to this many rows).
 const MEDIAN_VALUES: usize = 1 << 16;
 
+/// Most keyphasor dots drawn on an orbit (beyond it every other one is dropped, evenly).
+const KEYPHASOR_DOTS: usize = 4096;
+
+/// Diameter of a keyphasor dot [px].
+const KEYPHASOR_DOT_PX: u32 = 7;
+
 /// Arguments of `rotorid plot`.
 #[derive(Debug, clap::Args)]
 pub struct PlotArgs {
-    /// A response CSV from `rotorid simulate` (t,x,z,...) or an estimates CSV from
-    /// `rotorid identify` (t,m_x,...,rcond_z); `-` reads stdin.
-    #[arg(value_name = "INPUT.csv")]
+    /// A response CSV from `rotorid simulate` or `rotorid condition` (t,x,z,...), an
+    /// estimates CSV from `rotorid identify` (t,m_x,...,rcond_z), a record in another
+    /// format (MAT, TDMS, UFF58, NPY/NPZ, Parquet), or a raw acquisition with a
+    /// `--scenario` that has `[acquisition]`; `-` reads stdin (CSV).
+    #[arg(value_name = "INPUT")]
     pub input: String,
     /// The image to write: FILE.png or FILE.svg.
     #[arg(long, value_name = "FILE.png|FILE.svg")]
     pub out: std::path::PathBuf,
     /// Draw the true m, c, k of this scenario (dashed) on an estimates plot: `table1` or
-    /// a scenario TOML file.
+    /// a scenario TOML file. Its `[acquisition]` conditions a raw record before drawing it
+    /// and gives the keyphasor angle of the orbit's dots.
     #[arg(long, value_name = "table1|FILE.toml")]
     pub scenario: Option<String>,
     /// Start of the time window [s].
@@ -115,25 +134,57 @@ pub fn run(args: PlotArgs) -> anyhow::Result<()> {
     if let Some(out) = args.out.to_str() {
         check_distinct_files(&inputs, &[("--out", out)])?;
     }
-    let truth = match &args.scenario {
-        Some(s) => Some(ScenarioSpec::load(s)?.identification()?.truth),
+    let spec = match &args.scenario {
+        Some(s) => Some(ScenarioSpec::load(s)?),
         None => None,
     };
+    let truth = match &spec {
+        Some(spec) => Some(spec.identification()?.truth),
+        None => None,
+    };
+    let acquisition = spec.as_ref().and_then(|s| s.acquisition());
+    let keyphasor = acquisition.map_or(0.0, |a| a.keyphasor.angle);
+    let window = (args.from, args.to);
+    let title = Path::new(&args.input)
+        .file_name()
+        .map_or_else(|| args.input.clone(), |f| f.to_string_lossy().into_owned());
+    if tables::is_tabular(&args.input, None) {
+        let table = tables::read(&args.input)?;
+        let figure = match (&spec, acquisition) {
+            (Some(spec), Some(acq)) => {
+                conditioned_figure(&title, &table, spec, acq, window, keyphasor)?
+            }
+            _ => {
+                let c = tables::columns(&table, None)?;
+                let phi = c.speed.as_ref().map(|s| s[0].as_slice());
+                let d = ResponseData::from_columns(&c.t, &c.x, &c.z, phi, window, keyphasor);
+                response_figure(&format!("{title}: response"), &d, window)?
+            }
+        };
+        return save(&figure, &args.out);
+    }
     let (name, input) = open_input(&args.input)?;
     let (head, rest) = read_head(&name, input)?;
-    let kind = detect(&name, &head)?;
+    let kind = match (detect(&name, &head), &spec, acquisition) {
+        (Ok(kind), _, _) => kind,
+        (Err(_), Some(spec), Some(acq)) if args.input != "-" => {
+            let table = tables::read(&args.input)?;
+            let figure = conditioned_figure(&title, &table, spec, acq, window, keyphasor)?;
+            return save(&figure, &args.out);
+        }
+        (Err(e), _, _) => return Err(e),
+    };
     let input = std::io::Cursor::new(head).chain(rest);
     let title = Path::new(&name)
         .file_name()
         .map_or_else(|| name.clone(), |f| f.to_string_lossy().into_owned());
-    let window = (args.from, args.to);
     let figure = match kind {
         CsvKind::Response => {
-            if truth.is_some() {
+            if truth.is_some() && acquisition.is_none() {
                 eprintln!("note: --scenario only adds true values to an estimates plot; {name} is a response");
             }
-            let data = read_response(&name, input, window)?;
-            response_figure(&title, &data, window)?
+            let data = read_response(&name, input, window, keyphasor)?;
+            response_figure(&format!("{title}: response"), &data, window)?
         }
         CsvKind::Estimates => {
             let data = read_estimates(&name, input, window)?;
@@ -239,6 +290,62 @@ impl Extent {
     }
 }
 
+/// The keyphasor dots of an orbit: the shaft's position (x, z) [m] each time phi passes
+/// `angle` + 2 pi k, either way round, interpolated linearly between the samples around
+/// the crossing. At most [`KEYPHASOR_DOTS`]: when full, every other dot is dropped and
+/// only every `stride`-th crossing is kept from then on, so the dots stay even in time.
+#[derive(Debug, Clone)]
+pub struct KeyphasorDots {
+    angle: f64,
+    /// The previous sample inside the window: (turn index of phi, phi, x, z).
+    prev: Option<(f64, f64, f64, f64)>,
+    crossings: u64,
+    stride: u64,
+    /// The dots kept, (x, z) [m].
+    pub dots: Vec<(f64, f64)>,
+}
+
+impl KeyphasorDots {
+    /// No dots yet; `angle` is the keyphasor angle [rad].
+    pub fn new(angle: f64) -> Self {
+        Self {
+            angle,
+            prev: None,
+            crossings: 0,
+            stride: 1,
+            dots: Vec::new(),
+        }
+    }
+
+    /// One sample inside the window: shaft angle `phi` [rad] and position `x`, `z` [m]. A
+    /// non-finite phi breaks the sequence (no dot across it).
+    pub fn push(&mut self, phi: f64, x: f64, z: f64) {
+        if !phi.is_finite() {
+            self.prev = None;
+            return;
+        }
+        let turn = ((phi - self.angle) / std::f64::consts::TAU).floor();
+        if let Some((turn0, phi0, x0, z0)) = self.prev {
+            if turn != turn0 {
+                // the crossing nearest the previous sample, in the direction of travel
+                let k = if turn > turn0 { turn } else { turn0 };
+                let at = self.angle + std::f64::consts::TAU * k;
+                let s = ((at - phi0) / (phi - phi0)).clamp(0.0, 1.0);
+                if self.crossings.is_multiple_of(self.stride) {
+                    self.dots.push((x0 + s * (x - x0), z0 + s * (z - z0)));
+                    if self.dots.len() >= KEYPHASOR_DOTS {
+                        let kept: Vec<_> = self.dots.iter().copied().step_by(2).collect();
+                        self.dots = kept;
+                        self.stride *= 2;
+                    }
+                }
+                self.crossings += 1;
+            }
+        }
+        self.prev = Some((turn, phi, x, z));
+    }
+}
+
 /// A response, thinned.
 struct ResponseData {
     extent: Extent,
@@ -247,32 +354,96 @@ struct ResponseData {
     orbit: PathThinner,
     /// Largest |x| or |z| in the window.
     peak: f64,
+    /// Keyphasor dots, when the response has phi.
+    keyphasor: Option<KeyphasorDots>,
 }
 
-fn read_response<R: Read>(name: &str, input: R, window: Window) -> anyhow::Result<ResponseData> {
+impl ResponseData {
+    fn new(window: Window) -> Self {
+        Self {
+            extent: Extent::new(),
+            x: ColumnThinner::new(COLUMNS, window),
+            z: ColumnThinner::new(COLUMNS, window),
+            orbit: PathThinner::new(ORBIT_SEGMENTS),
+            peak: 0.0,
+            keyphasor: None,
+        }
+    }
+
+    /// One sample: t [s], x, z [m], phi [rad] when known.
+    fn push(&mut self, window: Window, t: f64, x: f64, z: f64, phi: Option<f64>) {
+        let before = self.extent.inside;
+        self.extent.push(t, window);
+        self.x.push(t, x);
+        self.z.push(t, z);
+        if self.extent.inside > before {
+            self.orbit.push(x, z);
+            self.peak = self.peak.max(x.abs()).max(z.abs());
+            if let (Some(k), Some(phi)) = (&mut self.keyphasor, phi) {
+                k.push(phi, x, z);
+            }
+        }
+    }
+
+    /// A response held in memory (SI); `phi` gives keyphasor dots at `keyphasor` [rad].
+    fn from_columns(
+        t: &[f64],
+        x: &[f64],
+        z: &[f64],
+        phi: Option<&[f64]>,
+        window: Window,
+        keyphasor: f64,
+    ) -> Self {
+        let mut d = Self::new(window);
+        if phi.is_some() {
+            d.keyphasor = Some(KeyphasorDots::new(keyphasor));
+        }
+        for i in 0..t.len() {
+            d.push(window, t[i], x[i], z[i], phi.map(|p| p[i]));
+        }
+        d
+    }
+}
+
+fn read_response<R: Read>(
+    name: &str,
+    input: R,
+    window: Window,
+    keyphasor: f64,
+) -> anyhow::Result<ResponseData> {
     let mut r = ResponseReader::new(name, input)?;
     r.print_conversions();
-    let mut d = ResponseData {
-        extent: Extent::new(),
-        x: ColumnThinner::new(COLUMNS, window),
-        z: ColumnThinner::new(COLUMNS, window),
-        orbit: PathThinner::new(ORBIT_SEGMENTS),
-        peak: 0.0,
-    };
+    let mut d = ResponseData::new(window);
+    if r.has_phi() {
+        d.keyphasor = Some(KeyphasorDots::new(keyphasor));
+    }
     while let Some(row) = r.next_row()? {
-        let before = d.extent.inside;
-        d.extent.push(row.t, window);
-        d.x.push(row.t, row.x);
-        d.z.push(row.t, row.z);
-        if d.extent.inside > before {
-            d.orbit.push(row.x, row.z);
-            d.peak = d.peak.max(row.x.abs()).max(row.z.abs());
-        }
+        d.push(window, row.t, row.x, row.z, row.speed.map(|s| s.phi));
     }
     if d.extent.first.is_nan() {
         bail!("{name}: the file has a header but no data rows");
     }
     Ok(d)
+}
+
+/// A raw record conditioned for `acq` (as `rotorid condition` does), as a response figure.
+fn conditioned_figure(
+    title: &str,
+    table: &rotorid_io::Table,
+    spec: &ScenarioSpec,
+    acq: &rotorid::acquisition::Acquisition,
+    window: Window,
+    keyphasor: f64,
+) -> anyhow::Result<Figure> {
+    let raw = tables::raw_record(table, acq)?;
+    let slow = tables::slow_roll(spec, acq)?;
+    let c = tables::condition_for(&raw, acq, slow.as_ref(), spec, &spec.knowledge()?, None)?;
+    tables::print_report(&c);
+    let d = ResponseData::from_columns(&c.t, &c.x, &c.z, Some(&c.phi), window, keyphasor);
+    if d.extent.first.is_nan() {
+        bail!("{}: the conditioned record is empty", table.file);
+    }
+    response_figure(&format!("{title}: conditioned response"), &d, window)
 }
 
 /// x(t), z(t) and the orbit, side by side.
@@ -294,20 +465,28 @@ fn response_figure(title: &str, d: &ResponseData, window: Window) -> anyhow::Res
     ])
     .with_x_range(t0, t1);
     let (ox, oz) = d.orbit.points();
+    let mut series = vec![Series::solid("", scaled(ox), scaled(oz), palette::BLUE).with_width(1)];
+    if let Some(k) = &d.keyphasor {
+        let (kx, kz): (Vec<f64>, Vec<f64>) = k.dots.iter().copied().unzip();
+        series.push(Series::dots(
+            format!(
+                "keyphasor (phi = {} deg)",
+                readable(k.angle.to_degrees().rem_euclid(360.0))
+            ),
+            scaled(kx),
+            scaled(kz),
+            palette::BLACK,
+            KEYPHASOR_DOT_PX,
+        ));
+    }
     let orbit = Panel::new(
         format!("(b) orbit, t = {}-{} s", readable(t0), readable(t1)),
         format!("horizontal x ({unit})"),
         format!("vertical z ({unit})"),
     )
-    .with_series(vec![Series::solid(
-        "",
-        scaled(ox),
-        scaled(oz),
-        palette::BLUE,
-    )
-    .with_width(1)])
+    .with_series(series)
     .with_equal_aspect();
-    Ok(Figure::new(format!("{title}: response"), vec![time, orbit])
+    Ok(Figure::new(title.to_owned(), vec![time, orbit])
         .side_by_side()
         .with_size(1600, 800))
 }
@@ -470,6 +649,58 @@ fn late_median(values: &[(f64, f64)], t0: f64, t1: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::TAU;
+
+    /// A circular 1X orbit of radius 1 sampled `per_turn` times a turn, phi = w t + phi0:
+    /// the keyphasor dots lie where phi = angle, i.e. at (cos angle, sin angle), one per
+    /// crossing of angle + 2 pi k (closed form).
+    fn circle(turns: f64, per_turn: usize, phi0: f64, sign: f64, angle: f64) -> KeyphasorDots {
+        let mut k = KeyphasorDots::new(angle);
+        let n = (turns * per_turn as f64) as usize;
+        for i in 0..=n {
+            let phi = phi0 + sign * TAU * i as f64 / per_turn as f64;
+            k.push(phi, phi.cos(), phi.sin());
+        }
+        k
+    }
+
+    #[test]
+    fn keyphasor_dots_sit_where_phi_passes_the_keyphasor_angle() {
+        for (angle, phi0, sign) in [(0.0, 0.3, 1.0), (1.0, -7.0, 1.0), (2.5, 40.0, -1.0)] {
+            let k = circle(10.0, 64, phi0, sign, angle);
+            // 10 turns from phi0 cross angle + 2 pi k exactly 10 times (phi0 != angle)
+            assert_eq!(k.dots.len(), 10, "angle {angle}, phi0 {phi0}, sign {sign}");
+            // linear interpolation on a chord of 2 pi / 64: within the sagitta, 1.2e-3
+            let sagitta = 1.0 - (TAU / 128.0).cos();
+            for &(x, z) in &k.dots {
+                let d = (x - angle.cos()).hypot(z - angle.sin());
+                assert!(d <= sagitta + 1e-12, "dot ({x}, {z}) is {d} from the mark");
+            }
+        }
+    }
+
+    #[test]
+    fn keyphasor_dots_skip_gaps_and_stay_even_when_thinned() {
+        let mut k = KeyphasorDots::new(0.0);
+        k.push(0.5, 0.0, 0.0);
+        k.push(f64::NAN, 0.0, 0.0);
+        k.push(TAU + 0.5, 0.0, 0.0);
+        assert!(k.dots.is_empty(), "no dot across a gap in phi");
+        // more crossings than are kept: every 2^j-th, evenly
+        let turns = 3 * KEYPHASOR_DOTS;
+        let mut k = KeyphasorDots::new(0.0);
+        for i in 0..=(4 * turns) {
+            let phi = 0.1 + TAU * i as f64 / 4.0;
+            k.push(phi, i as f64, 0.0);
+        }
+        assert!(k.dots.len() < KEYPHASOR_DOTS && k.dots.len() >= KEYPHASOR_DOTS / 4);
+        let steps: Vec<f64> = k.dots.windows(2).map(|w| w[1].0 - w[0].0).collect();
+        assert!(
+            steps.iter().all(|&s| (s - steps[0]).abs() < 1e-9),
+            "uneven thinning"
+        );
+        assert_eq!(steps[0], 4.0 * k.stride as f64);
+    }
 
     #[test]
     fn headers_pick_the_kind() {

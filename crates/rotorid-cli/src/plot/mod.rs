@@ -64,6 +64,9 @@ pub enum LineStyle {
     Solid,
     /// A dashed line (true values).
     Dashed,
+    /// A filled dot at each point, no line (keyphasor marks on an orbit); `width` is the
+    /// dot's diameter in pixels.
+    Dots,
 }
 
 /// One curve: y against x, both in the panel's display units.
@@ -104,6 +107,21 @@ impl Series {
     pub fn dashed(label: impl Into<String>, x: Vec<f64>, y: Vec<f64>, color: Rgb) -> Self {
         Self {
             style: LineStyle::Dashed,
+            ..Self::solid(label, x, y, color)
+        }
+    }
+
+    /// A filled dot of `diameter` pixels at each point, unjoined.
+    pub fn dots(
+        label: impl Into<String>,
+        x: Vec<f64>,
+        y: Vec<f64>,
+        color: Rgb,
+        diameter: u32,
+    ) -> Self {
+        Self {
+            style: LineStyle::Dots,
+            width: diameter,
             ..Self::solid(label, x, y, color)
         }
     }

@@ -311,6 +311,19 @@ fn draw_panel<DB: DrawingBackend>(
             filled: false,
             stroke_width: s.width * px.k,
         };
+        if s.style == LineStyle::Dots {
+            let r = (s.width * px.k / 2).max(1) as i32;
+            let fill = style.filled();
+            let inside =
+                s.x.iter()
+                    .zip(&s.y)
+                    .map(|(&x, &y)| (x, y))
+                    .filter(|&(x, y)| (x0..=x1).contains(&x) && (y0..=y1).contains(&y));
+            chart
+                .draw_series(inside.map(|p| Circle::new(p, r, fill)))
+                .map_err(de)?;
+            continue;
+        }
         for run in finite_runs(&s.x, &s.y) {
             let run = decimate(&run, x0, x1, pw as usize);
             for piece in clip_polyline(&run, &rect) {
@@ -325,6 +338,7 @@ fn draw_panel<DB: DrawingBackend>(
                         LineStyle::Dashed => {
                             chart.draw_series(DashedLineSeries::new(stroke, px.dash, px.gap, style))
                         }
+                        LineStyle::Dots => continue, // drawn above
                     }
                     .map_err(de)?;
                 }
@@ -406,6 +420,11 @@ fn draw_legend<DB: DrawingBackend>(
                 10 * k,
                 6 * k,
                 style,
+            )),
+            LineStyle::Dots => area.draw(&Circle::new(
+                ((xa + xb) / 2, y),
+                (s.width * px.k / 2).max(1) as i32,
+                style.filled(),
             )),
         }
         .map_err(de)?;

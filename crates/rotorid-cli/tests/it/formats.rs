@@ -175,7 +175,80 @@ fn a_raw_acquisition_is_conditioned_and_identified() {
         .map(|l| l.split(',').nth(1).unwrap().parse::<f64>().unwrap().abs())
         .fold(0.0, f64::max);
     assert!((5e-6..3e-5).contains(&peak), "peak x {peak:e} m");
-    // identified from the raw record directly: within 4 standard errors of the truth
+    // the conditioned orbit with its keyphasor dots, drawn from the raw record and from
+    // the conditioned CSV alike
+    let orbits: Vec<Vec<(f64, f64)>> = [&raw, &resp]
+        .iter()
+        .enumerate()
+        .map(|(i, input)| {
+            let svg = dir.path().join(format!("orbit{i}.svg"));
+            run(&[
+                "plot",
+                input.to_str().unwrap(),
+                "--scenario",
+                rig.to_str().unwrap(),
+                "--out",
+                svg.to_str().unwrap(),
+            ]);
+            let text = std::fs::read_to_string(&svg).unwrap();
+            assert!(
+                text.contains("keyphasor (phi = 0 deg)"),
+                "no keyphasor legend"
+            );
+            circles(&text)
+        })
+        .collect();
+    assert_eq!(orbits[0], orbits[1], "raw and conditioned CSV plot alike");
+    // one dot per keyphasor event (1200 rpm for 1 s: 20), then the legend's dot; each where
+    // the test finds phi passing 0 (mod 2 pi) in the conditioned CSV, x and z interpolated
+    // linearly, up to the plot's map from metres to pixels (equal scales, y downwards)
+    let dots = &orbits[0][..orbits[0].len() - 1];
+    let rows: Vec<[f64; 4]> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|f| f.parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3]]
+        })
+        .collect();
+    let tau = std::f64::consts::TAU;
+    let expected: Vec<(f64, f64)> = rows
+        .windows(2)
+        .filter(|w| (w[1][3] / tau).floor() > (w[0][3] / tau).floor())
+        .map(|w| {
+            let s = (tau * (w[1][3] / tau).floor() - w[0][3]) / (w[1][3] - w[0][3]);
+            (
+                w[0][1] + s * (w[1][1] - w[0][1]),
+                w[0][2] + s * (w[1][2] - w[0][2]),
+            )
+        })
+        .collect();
+    assert!(
+        (19..=21).contains(&expected.len()),
+        "{} events",
+        expected.len()
+    );
+    assert_eq!(dots.len(), expected.len());
+    // least squares for cx = a + k x, cy = b - k z
+    let n = dots.len() as f64;
+    let mean = |f: &dyn Fn(usize) -> f64| (0..dots.len()).map(f).sum::<f64>() / n;
+    let (mx, mz) = (mean(&|i| expected[i].0), mean(&|i| expected[i].1));
+    let (mcx, mcy) = (mean(&|i| dots[i].0), mean(&|i| dots[i].1));
+    let num = mean(&|i| {
+        (expected[i].0 - mx) * (dots[i].0 - mcx) - (expected[i].1 - mz) * (dots[i].1 - mcy)
+    });
+    let den = mean(&|i| (expected[i].0 - mx).powi(2) + (expected[i].1 - mz).powi(2));
+    let k = num / den;
+    assert!(k > 0.0, "{k} px/m");
+    for (d, e) in dots.iter().zip(&expected) {
+        let (cx, cy) = (mcx + k * (e.0 - mx), mcy - k * (e.1 - mz));
+        let off = (d.0 - cx).hypot(d.1 - cy);
+        assert!(
+            off < 1.5,
+            "dot {d:?} is {off} px from where phi = 0 ({cx}, {cy})"
+        );
+    }
+
     let sum = dir.path().join("s.json");
     run(&[
         "identify",
@@ -208,4 +281,17 @@ fn a_raw_acquisition_is_conditioned_and_identified() {
             p["parameter"]
         );
     }
+}
+
+/// The centres (cx, cy) of the `<circle>` elements of an SVG, in order.
+fn circles(svg: &str) -> Vec<(f64, f64)> {
+    let attr = |el: &str, name: &str| -> f64 {
+        let start = el.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        let end = start + el[start..].find('"').unwrap();
+        el[start..end].parse().unwrap()
+    };
+    svg.split("<circle")
+        .skip(1)
+        .map(|el| (attr(el, "cx"), attr(el, "cy")))
+        .collect()
 }
