@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Build and test rotorid's Python package from this checkout: a virtual environment
 # (created once, then reused), the package installed with pip (maturin builds the Rust
-# extension in release mode), the `rotorid` command for the parity tests, then pytest.
+# extension, in the dev profile), the `rotorid` command for the parity tests (dev profile),
+# then pytest.
 # Needs the Rust toolchain and Python >= 3.10; everything else comes from PyPI.
 #
 #   crates/rotorid-py/test.sh [pytest arguments]
@@ -28,13 +29,18 @@ echo "== installing the test requirements"
     "ipykernel>=6.29,<8" "dask>=2024.1" "pandas>=2.0,<4" "numpy>=1.26,<3" \
     "matplotlib>=3.8,<4" "mypy>=1.18,<3"
 
+# The dev profile here (MATURIN_PEP517_ARGS overrides): it reuses the dependencies that
+# `cargo test --workspace` compiled (optimised, see Cargo.toml) where a release build
+# compiles them all again; a user's `pip install` builds in release.
 echo "== building and installing the package (pip install crates/rotorid-py)"
-CARGO_TARGET_DIR="$target" "$py" -m pip install --quiet --disable-pip-version-check \
-    --force-reinstall --no-deps "$here"
+MATURIN_PEP517_ARGS="${MATURIN_PEP517_ARGS:---profile dev}" CARGO_TARGET_DIR="$target" \
+    "$py" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps "$here"
 
+# the dev profile (dependencies optimised, see Cargo.toml): after `cargo test --workspace`
+# it is already built, where a release build would compile every dependency again
 echo "== building the rotorid command (parity tests)"
-(cd "$root" && CARGO_TARGET_DIR="$target" cargo build --release --quiet -p rotorid-cli)
-export ROTORID_BIN="$target/release/rotorid"
+(cd "$root" && CARGO_TARGET_DIR="$target" cargo build --quiet -p rotorid-cli)
+export ROTORID_BIN="$target/debug/rotorid"
 
 echo "== pytest"
 cd "$here"

@@ -249,6 +249,39 @@ pub fn mat_v5_bytes(file: &str, table: &Table) -> Result<Vec<u8>, WriteError> {
 
 /// `table` as a Parquet file (required DOUBLE columns, snappy); `file` names it in errors.
 pub fn parquet_bytes(file: &str, table: &Table) -> Result<Vec<u8>, WriteError> {
+    let columns: Vec<(&str, ParquetColumn<'_>)> = table
+        .channels
+        .iter()
+        .map(|c| (c.name.as_str(), ParquetColumn::Required(&c.data)))
+        .collect();
+    parquet_columns_bytes(file, &columns)
+}
+
+/// One column for [`parquet_columns_bytes`].
+#[derive(Debug, Clone, Copy)]
+pub enum ParquetColumn<'a> {
+    /// A `required double` column: every row has a value.
+    Required(&'a [f64]),
+    /// An `optional double` column: `None` is a null (pandas reads NaN, polars null), e.g.
+    /// an estimate withheld as ill-conditioned.
+    Optional(&'a [Option<f64>]),
+}
+
+impl ParquetColumn<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Self::Required(v) => v.len(),
+            Self::Optional(v) => v.len(),
+        }
+    }
+}
+
+/// Named columns of equal length as a Parquet file (DOUBLE, snappy, row groups of 2^20
+/// rows); `file` names it in errors.
+pub fn parquet_columns_bytes(
+    file: &str,
+    columns: &[(&str, ParquetColumn<'_>)],
+) -> Result<Vec<u8>, WriteError> {
     use parquet::basic::{Compression, Repetition, Type as Physical};
     use parquet::data_type::DoubleType;
     use parquet::file::properties::WriterProperties;
@@ -260,19 +293,23 @@ pub fn parquet_bytes(file: &str, table: &Table) -> Result<Vec<u8>, WriteError> {
         container: "Parquet",
         message: e.to_string(),
     };
-    let rows = table.channels.first().map_or(0, |c| c.data.len());
+    let rows = columns.first().map_or(0, |(_, c)| c.len());
     let mut fields = Vec::new();
-    for c in &table.channels {
-        if c.data.len() != rows {
+    for (name, c) in columns {
+        if c.len() != rows {
             return Err(WriteError::Unrepresentable {
                 file: file.to_string(),
-                channel: c.name.clone(),
-                why: format!("{} samples where the first channel has {rows}: Parquet columns share their rows", c.data.len()),
+                channel: (*name).to_string(),
+                why: format!("{} samples where the first channel has {rows}: Parquet columns share their rows", c.len()),
             });
         }
+        let repetition = match c {
+            ParquetColumn::Required(_) => Repetition::REQUIRED,
+            ParquetColumn::Optional(_) => Repetition::OPTIONAL,
+        };
         fields.push(Arc::new(
-            Type::primitive_type_builder(&c.name, Physical::DOUBLE)
-                .with_repetition(Repetition::REQUIRED)
+            Type::primitive_type_builder(name, Physical::DOUBLE)
+                .with_repetition(repetition)
                 .build()
                 .map_err(perr)?,
         ));
@@ -292,14 +329,27 @@ pub fn parquet_bytes(file: &str, table: &Table) -> Result<Vec<u8>, WriteError> {
     let mut w = SerializedFileWriter::new(&mut out, schema, props).map_err(perr)?;
     const GROUP: usize = 1 << 20;
     let mut start = 0;
+    let mut values = Vec::new();
+    let mut levels = Vec::new();
     while start < rows || (rows == 0 && start == 0) {
         let end = (start + GROUP).min(rows);
         let mut rg = w.next_row_group().map_err(perr)?;
         let mut k = 0;
         while let Some(mut col) = rg.next_column().map_err(perr)? {
-            col.typed::<DoubleType>()
-                .write_batch(&table.channels[k].data[start..end], None, None)
-                .map_err(perr)?;
+            let typed = col.typed::<DoubleType>();
+            match columns[k].1 {
+                ParquetColumn::Required(v) => typed.write_batch(&v[start..end], None, None),
+                ParquetColumn::Optional(v) => {
+                    values.clear();
+                    levels.clear();
+                    for x in &v[start..end] {
+                        levels.push(i16::from(x.is_some()));
+                        values.extend(x);
+                    }
+                    typed.write_batch(&values, Some(&levels), None)
+                }
+            }
+            .map_err(perr)?;
             col.close().map_err(perr)?;
             k += 1;
         }

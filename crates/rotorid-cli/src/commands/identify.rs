@@ -60,12 +60,24 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         (name, stream::Source::Csv(input))
     };
     let live = args.input == "-" || !std::fs::metadata(&args.input).is_ok_and(|m| m.is_file());
-    let out = Output::create(&args.out, FileMode::Direct)?;
+    // Parquet is written whole at the end (atomically); CSV row by row as it goes
+    let parquet = args.out != "-"
+        && matches!(
+            rotorid_io::Format::from_path(std::path::Path::new(&args.out)),
+            Ok(rotorid_io::Format::Parquet)
+        );
+    let mode = if parquet {
+        FileMode::Atomic
+    } else {
+        FileMode::Direct
+    };
+    let out = Output::create(&args.out, mode)?;
     let to_stdout = out.is_stdout();
     let io = stream::Io {
         name: &name,
         out_name: &args.out,
         live,
+        parquet,
         every: args.every.unwrap_or(1),
     };
     let mut ident = match stream::identify(&io, input, out, &spec, &method, args.time_tolerance) {

@@ -33,6 +33,28 @@ pub const ESTIMATES_HEADER: [&str; 9] = [
     "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z",
 ];
 
+/// `rows` as a Parquet file with the CSV's columns (optional DOUBLE: a withheld estimate is
+/// a null, where the CSV leaves the field empty); `file` names it in errors.
+pub fn estimates_parquet(
+    file: &str,
+    rows: &[EstimateRow],
+) -> Result<Vec<u8>, rotorid_io::WriteError> {
+    use rotorid_io::write::{parquet_columns_bytes, ParquetColumn};
+    let t: Vec<f64> = rows.iter().map(|r| r.t).collect();
+    let values: Vec<Vec<Option<f64>>> = (0..6)
+        .map(|k| rows.iter().map(|r| r.values.to_array()[k]).collect())
+        .collect();
+    let rcond_x: Vec<f64> = rows.iter().map(|r| r.rcond_x).collect();
+    let rcond_z: Vec<f64> = rows.iter().map(|r| r.rcond_z).collect();
+    let mut columns = vec![(ESTIMATES_HEADER[0], ParquetColumn::Required(&t))];
+    for (k, v) in values.iter().enumerate() {
+        columns.push((ESTIMATES_HEADER[1 + k], ParquetColumn::Optional(v)));
+    }
+    columns.push((ESTIMATES_HEADER[7], ParquetColumn::Required(&rcond_x)));
+    columns.push((ESTIMATES_HEADER[8], ParquetColumn::Required(&rcond_z)));
+    parquet_columns_bytes(file, &columns)
+}
+
 /// One row of the estimates CSV.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EstimateRow {

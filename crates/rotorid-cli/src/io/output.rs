@@ -289,7 +289,7 @@ fn open_file(path: &Path, mode: FileMode) -> anyhow::Result<(File, Dest)> {
 /// Open `arg` for reading: `-` is stdin. Returns the name to use in messages (`<stdin>`
 /// for `-`) and the reader (unbuffered: the CSV reader buffers). The file is recorded, so
 /// that no output of this run replaces it.
-pub fn open_input(arg: &str) -> anyhow::Result<(String, Box<dyn Read>)> {
+pub fn open_input(arg: &str) -> anyhow::Result<(String, Box<dyn Read + Send>)> {
     same_file::note_input(arg);
     if arg == "-" {
         Ok(("<stdin>".to_owned(), Box::new(io::stdin())))

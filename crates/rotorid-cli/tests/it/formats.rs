@@ -77,6 +77,88 @@ fn every_format_identifies_bit_for_bit_like_the_csv() {
 }
 
 #[test]
+fn estimates_as_parquet_hold_the_csv_values_and_nulls_where_it_is_empty() {
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+    use parquet::record::Field;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_string_lossy().into_owned();
+    let rec = p("r.csv");
+    run(&[
+        "simulate",
+        "--scenario",
+        "table1",
+        "--duration",
+        "0.3",
+        "--snr-db",
+        "40",
+        "--out",
+        &rec,
+        "-q",
+    ]);
+    for method in ["algebraic", "refine"] {
+        let (csv, pq) = (
+            p(&format!("e_{method}.csv")),
+            p(&format!("e_{method}.parquet")),
+        );
+        for out in [&csv, &pq] {
+            let mut args = vec![
+                "identify",
+                &rec,
+                "--scenario",
+                "table1",
+                "--method",
+                method,
+                "--out",
+                out,
+                "-q",
+            ];
+            if method == "algebraic" {
+                args.extend(["--every", "7"]);
+            }
+            run(&args);
+        }
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let expected: Vec<Vec<Option<f64>>> = lines
+            .map(|l| l.split(',').map(|f| f.parse().ok()).collect())
+            .collect();
+        let reader = SerializedFileReader::new(std::fs::File::open(&pq).unwrap()).unwrap();
+        let mut got = Vec::new();
+        for row in reader.get_row_iter(None).unwrap() {
+            let row = row.unwrap();
+            let mut values = Vec::new();
+            for (k, (name, field)) in row.get_column_iter().enumerate() {
+                assert_eq!(name, header[k], "{method}: column {k}");
+                values.push(match field {
+                    Field::Double(v) => Some(*v),
+                    Field::Null => None,
+                    other => panic!("{method}: {name} holds {other:?}"),
+                });
+            }
+            got.push(values);
+        }
+        assert!(
+            expected.len() > 1 || method == "refine",
+            "{method}: {} rows",
+            expected.len()
+        );
+        assert_eq!(got.len(), expected.len(), "{method}: rows");
+        for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
+            let bits =
+                |v: &[Option<f64>]| v.iter().map(|x| x.map(f64::to_bits)).collect::<Vec<_>>();
+            assert_eq!(bits(g), bits(e), "{method}: row {i}");
+        }
+        if method == "algebraic" {
+            assert!(
+                expected[0][1].is_none(),
+                "the first instant is withheld (a null)"
+            );
+        }
+    }
+}
+
+#[test]
 fn columns_pick_channels_by_other_names_and_inspect_lists_them() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("r.csv");

@@ -196,19 +196,16 @@ fn push_exponent(out: &mut Vec<u8>, e: i32) {
 }
 
 /// `raw` (a field, ASCII blanks already trimmed) as `str::parse::<f64>` reads it after
-/// `str::trim`, bit for bit; `None` where that refuses it. Plain decimal text (digits,
-/// sign, point, exponent) takes the `fast-float2` path, correctly rounded as `str::parse`
-/// is; anything else (`inf`, `NaN`, Unicode blanks, garbage) goes to `str::parse`.
+/// `str::trim`, bit for bit; `None` where that refuses it. `fast-float2` first: it
+/// accepts exactly the texts `str::parse` accepts (decimal with sign, point and exponent;
+/// `inf`, `infinity`, `nan` in any case, signed) and rounds them correctly as it does (the
+/// property tests below check both claims); what it refuses (Unicode blanks, garbage)
+/// goes to `str::parse`, which trims and decides. No pre-scan of the bytes: that cost a
+/// third of the CSV reader's time.
 #[inline]
 pub fn parse_f64(raw: &[u8]) -> Option<f64> {
-    let plain = !raw.is_empty()
-        && raw
-            .iter()
-            .all(|b| matches!(b, b'0'..=b'9' | b'.' | b'-' | b'+' | b'e' | b'E'));
-    if plain {
-        if let Ok(v) = fast_float2::parse::<f64, _>(raw) {
-            return Some(v);
-        }
+    if let Ok(v) = fast_float2::parse::<f64, _>(raw) {
+        return Some(v);
     }
     std::str::from_utf8(raw)
         .ok()
@@ -425,10 +422,52 @@ mod tests {
             same_as_std(&text)?;
         }
 
-        /// ... and on anything made of its characters.
+        /// ... and on anything made of its characters, or of the words infinity and NaN.
         #[test]
         fn parse_is_std_on_garbage(text in "[-+.eE0-9]{0,12}") {
             same_as_std(&text)?;
+        }
+
+        #[test]
+        fn parse_is_std_on_words(text in "[-+ ]?[iInNfFaAtTyY0-9.e]{0,9}[ \t]?") {
+            same_as_std(&text)?;
+        }
+    }
+
+    #[test]
+    fn parse_is_std_on_special_words() {
+        for text in [
+            "inf",
+            "-inf",
+            "+inf",
+            "INF",
+            "Infinity",
+            "-infinity",
+            "+INFINITY",
+            "infinit",
+            "infinityy",
+            "in",
+            "nan",
+            "NaN",
+            "-nan",
+            "+NAN",
+            "nana",
+            "na",
+            "-",
+            "+",
+            "",
+            "1e",
+            "1e+",
+            ".e1",
+            "+.5",
+            "-.5e-3",
+            "5.",
+            "0x10",
+            "1_0",
+            "1 2",
+            "\u{a0}1",
+        ] {
+            same_as_std(text).unwrap();
         }
     }
 

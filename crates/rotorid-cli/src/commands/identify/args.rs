@@ -196,8 +196,10 @@ pub struct IdentifyArgs {
     pub time_tolerance: f64,
 
     /// The estimates CSV, or `-` for stdout. Written as it goes (a file can be followed
-    /// while it grows); after an error it holds the whole rows written before it.
-    #[arg(long, short, value_name = "ESTIMATES.csv|-")]
+    /// while it grows); after an error it holds the whole rows written before it. A name
+    /// ending in `.parquet` writes the same columns as Parquet (a withheld estimate is a
+    /// null), whole at the end: nothing on error.
+    #[arg(long, short, value_name = "ESTIMATES.csv|ESTIMATES.parquet|-")]
     pub out: String,
 
     /// Also write a JSON summary: final values, identification times, truth and relative

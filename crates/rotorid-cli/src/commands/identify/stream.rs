@@ -7,6 +7,11 @@
 //! just before a read that may block, the output is flushed and the session starts on the
 //! samples it holds (its time grid is then fitted over those; a regular file's over the
 //! first `DEFAULT_GRID_HEAD` stamps).
+//!
+//! A regular file is read on a second thread: it splits and parses rows in batches of
+//! [`BATCH_ROWS`] while this one identifies the previous batch (at most [`BATCHES_AHEAD`]
+//! batches ahead, so memory stays bounded). Rows reach the session in file order, and a
+//! bad row's error arrives after every row before it, as on one thread.
 
 use std::cell::RefCell;
 use std::io::{self, Read, Write};
@@ -19,9 +24,16 @@ use rotorid::pipeline::{
 };
 use rotorid::SpeedProfile;
 
+use crate::io::estimates_csv::estimates_parquet;
 use crate::io::{
     CsvError, EstimateRow, EstimatesWriter, Output, ParameterSet, ResponseReader, ScenarioSpec,
 };
+
+/// Rows a reader thread parses before it hands them over.
+const BATCH_ROWS: usize = 4096;
+
+/// Batches the reader thread may run ahead of the identification.
+const BATCHES_AHEAD: usize = 4;
 
 /// Names and options of one run.
 pub(crate) struct Io<'a> {
@@ -31,6 +43,8 @@ pub(crate) struct Io<'a> {
     pub out_name: &'a str,
     /// Whether reads may block (stdin, pipe, FIFO).
     pub live: bool,
+    /// Write the estimates as Parquet (at the end) rather than CSV (as they come).
+    pub parquet: bool,
     /// Write every N-th algebraic estimate.
     pub every: u64,
 }
@@ -47,6 +61,8 @@ struct Rows {
     /// the header, is written for an input that gives no estimate.
     out: Option<Output>,
     writer: Option<EstimatesWriter<Output>>,
+    /// For a Parquet output: the rows, written when the run ends (nothing on error).
+    parquet: Option<Vec<EstimateRow>>,
     /// Estimates seen (the `--every` counter).
     seen: u64,
     every: u64,
@@ -59,6 +75,10 @@ impl Rows {
         let n = self.seen;
         self.seen += 1;
         if !n.is_multiple_of(self.every) || self.error.is_some() {
+            return;
+        }
+        if let Some(rows) = self.parquet.as_mut() {
+            rows.push(row_of(e));
             return;
         }
         if self.writer.is_none() {
@@ -125,7 +145,7 @@ impl<R: Read> Read for HookedInput<R> {
 /// record).
 pub(crate) enum Source {
     /// The response CSV (a file or a live pipe).
-    Csv(Box<dyn Read>),
+    Csv(Box<dyn Read + Send>),
     /// t \[s\], x, z \[m\] and optional phi \[rad\], phi_dot \[rad/s\], phi_ddot
     /// \[rad/s^2\].
     Columns(rotorid_io::SiColumns),
@@ -161,12 +181,14 @@ pub(crate) fn identify(
         rows: Rows {
             out,
             writer: None,
+            parquet: io.parquet.then(Vec::new),
             seen: 0,
             every: io.every,
             error: None,
         },
     }));
     let result = match input {
+        Source::Csv(input) if !io.live => read_all_threaded(io, input, &state, profile),
         Source::Csv(input) => {
             let hooked = HookedInput {
                 inner: input,
@@ -189,6 +211,7 @@ pub(crate) fn identify(
         return Err(e).with_context(|| format!("cannot write {}", io.out_name));
     }
     // After an error, keep the whole rows written so far.
+    let parquet = rows.parquet.take();
     let Some(mut out) = rows.into_output().or(held) else {
         anyhow::bail!("no output for {}", io.out_name);
     };
@@ -199,17 +222,22 @@ pub(crate) fn identify(
             return Err(e);
         }
     };
-    if let Some(f) = ident.final_estimate() {
-        let v = f.values;
+    let last = ident.final_estimate().map(|f| EstimateRow {
+        t: f.t_s,
+        values: ParameterSet::from_array(f.values),
+        rcond_x: f.rcond.x,
+        rcond_z: f.rcond.z,
+    });
+    if let Some(mut table) = parquet {
+        table.extend(last);
+        let bytes = estimates_parquet(io.out_name, &table)?;
+        out.write_all(&bytes)
+            .with_context(|| format!("cannot write {}", io.out_name))?;
+    } else if let Some(last) = last {
         let mut w = EstimatesWriter::new(&mut out)
             .with_context(|| format!("cannot write {}", io.out_name))?;
-        w.write(&EstimateRow {
-            t: f.t_s,
-            values: ParameterSet::from_array(v),
-            rcond_x: f.rcond.x,
-            rcond_z: f.rcond.z,
-        })
-        .with_context(|| format!("cannot write {}", io.out_name))?;
+        w.write(&last)
+            .with_context(|| format!("cannot write {}", io.out_name))?;
     }
     out.commit()?;
     Ok(ident)
@@ -222,17 +250,7 @@ fn read_all<R: Read>(
     state: &Rc<RefCell<State>>,
     profile: Option<SpeedProfile>,
 ) -> anyhow::Result<()> {
-    let mut reader = ResponseReader::new(io.name, input)?;
-    reader.print_conversions();
-    if !reader.has_phi() && profile.is_none() {
-        return Err(CsvError::file(
-            io.name,
-            "has no phi, phi_dot, phi_ddot columns and the scenario has no [speed] section: \
-             give the rotor angle in the data or the speed profile in the scenario"
-                .to_owned(),
-        )
-        .into());
-    }
+    let mut reader = open_rows(io, input, profile)?;
     while let Some(row) = reader.next_row()? {
         let s = Sample {
             t: Some(row.t),
@@ -245,6 +263,84 @@ fn read_all<R: Read>(
         })?;
     }
     Ok(())
+}
+
+/// The response CSV reader of `input`, its unit conversions noted on stderr; an error when
+/// neither the file nor the scenario gives the speed.
+fn open_rows<R: Read>(
+    io: &Io,
+    input: R,
+    profile: Option<SpeedProfile>,
+) -> anyhow::Result<ResponseReader<R>> {
+    let reader = ResponseReader::new(io.name, input)?;
+    reader.print_conversions();
+    if !reader.has_phi() && profile.is_none() {
+        return Err(CsvError::file(
+            io.name,
+            "has no phi, phi_dot, phi_ddot columns and the scenario has no [speed] section: \
+             give the rotor angle in the data or the speed profile in the scenario"
+                .to_owned(),
+        )
+        .into());
+    }
+    Ok(reader)
+}
+
+/// Every row of the regular file `input` into the session, parsed on a second thread
+/// (module doc).
+fn read_all_threaded(
+    io: &Io,
+    input: Box<dyn Read + Send>,
+    state: &Rc<RefCell<State>>,
+    profile: Option<SpeedProfile>,
+) -> anyhow::Result<()> {
+    let mut reader = open_rows(io, input, profile)?;
+    type Batch = Result<Vec<crate::io::response_csv::ResponseRow>, CsvError>;
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Batch>(BATCHES_AHEAD);
+    std::thread::scope(|scope| {
+        scope.spawn(move || loop {
+            let mut batch = Vec::with_capacity(BATCH_ROWS);
+            let end = loop {
+                match reader.next_row() {
+                    Ok(Some(row)) => {
+                        batch.push(row);
+                        if batch.len() == BATCH_ROWS {
+                            break None;
+                        }
+                    }
+                    Ok(None) => break Some(Ok(())),
+                    Err(e) => break Some(Err(e)),
+                }
+            };
+            // a send fails only when the identification stopped: nothing more to do
+            if !batch.is_empty() && tx.send(Ok(batch)).is_err() {
+                return;
+            }
+            match end {
+                None => {}
+                Some(Ok(())) => return,
+                Some(Err(e)) => {
+                    let _ = tx.send(Err(e));
+                    return;
+                }
+            }
+        });
+        // rx is dropped on the first error, which stops the reader at its next send
+        for batch in rx {
+            for row in batch? {
+                let s = Sample {
+                    t: Some(row.t),
+                    x: row.x,
+                    z: row.z,
+                    speed: row.speed,
+                };
+                push(io, state, &s, |m| {
+                    CsvError::line(io.name, row.line, m).into()
+                })?;
+            }
+        }
+        Ok(())
+    })
 }
 
 /// One sample into the session; `at` locates a refused sample's message (its line or
