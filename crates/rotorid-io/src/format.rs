@@ -68,6 +68,9 @@ pub fn read_table(path: impl AsRef<Path>) -> Result<Table, ReadError> {
         return crate::csv::read_csv_table(&file, std::io::BufReader::with_capacity(1 << 16, f))
             .map_err(|e| ReadError::Csv(Box::new(e)));
     }
+    if format == Format::Parquet {
+        return crate::parquet::read_file(&file, path);
+    }
     let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
         file: file.clone(),
         source,

@@ -21,7 +21,7 @@
 use bytes::Bytes;
 use parquet::basic::{ConvertedType, Type as Physical};
 use parquet::column::reader::ColumnReader;
-use parquet::file::reader::{FileReader, SerializedFileReader};
+use parquet::file::reader::{ChunkReader, FileReader, SerializedFileReader};
 
 use crate::error::ReadError;
 use crate::table::{Channel, Table};
@@ -30,7 +30,33 @@ const BATCH: usize = 65_536;
 
 /// Reads a Parquet file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
-    let run = || read_inner(file, bytes);
+    let data = Bytes::copy_from_slice(bytes);
+    let size = bytes.len() as u64;
+    let chunk = |start: u64, len: u64| Ok(bytes[start as usize..(start + len) as usize].to_vec());
+    guarded(file, || read_inner(file, data, size, &chunk))
+}
+
+/// Reads the Parquet file at `path` column chunk by column chunk: memory holds the channels
+/// and one column chunk (and the `parquet` crate's page buffers), never the whole file.
+pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
+    use std::os::unix::fs::FileExt as _;
+    let io = |source| ReadError::Io {
+        file: file.to_string(),
+        source,
+    };
+    let f = std::fs::File::open(path).map_err(io)?;
+    let size = f.metadata().map_err(io)?.len();
+    let g = f.try_clone().map_err(io)?;
+    let chunk = move |start: u64, len: u64| {
+        let mut buf = vec![0u8; len as usize];
+        g.read_exact_at(&mut buf, start).map_err(io)?;
+        Ok(buf)
+    };
+    guarded(file, || read_inner(file, f, size, &chunk))
+}
+
+/// `run`, with a panic of the third-party parser on a hostile file made an error.
+fn guarded(file: &str, run: impl FnOnce() -> Result<Table, ReadError>) -> Result<Table, ReadError> {
     // A third-party parser: a panic on a hostile file becomes an error here.
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|_| {
         Err(ReadError::Container {
@@ -59,9 +85,18 @@ enum Kind {
     Unsigned,
 }
 
-fn read_inner(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
-    let reader =
-        SerializedFileReader::new(Bytes::copy_from_slice(bytes)).map_err(|e| err(file, None, e))?;
+/// The bytes `[start, start + len)` of the file (within its size: checked by the caller).
+type ChunkFn<'a> = dyn Fn(u64, u64) -> Result<Vec<u8>, ReadError> + 'a;
+
+/// The table of a Parquet file of `size` bytes, read through `source`; `chunk` gives a
+/// column chunk's bytes for [`check_pages`].
+fn read_inner<R: ChunkReader + 'static>(
+    file: &str,
+    source: R,
+    size: u64,
+    chunk: &ChunkFn<'_>,
+) -> Result<Table, ReadError> {
+    let reader = SerializedFileReader::new(source).map_err(|e| err(file, None, e))?;
     let meta = reader.metadata();
     let schema = meta.file_metadata().schema_descr();
     let rows: i64 = meta
@@ -69,7 +104,7 @@ fn read_inner(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
         .iter()
         .map(|g| g.num_rows().max(0))
         .fold(0i64, i64::saturating_add);
-    let limit = (bytes.len() as u64).saturating_mul(1032);
+    let limit = size.saturating_mul(1032);
     if rows as u64 > limit {
         return Err(ReadError::Invalid {
             file: file.to_string(),
@@ -85,7 +120,8 @@ fn read_inner(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
             let start = cc.dictionary_page_offset().unwrap_or(cc.data_page_offset());
             check_pages(
                 file,
-                bytes,
+                size,
+                chunk,
                 &cc.column_path().string(),
                 start,
                 cc.compressed_size(),
@@ -237,11 +273,13 @@ fn read_inner(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
     })
 }
 
-/// Walks the page headers of a column chunk of `len` bytes at `start`, checking each page's
-/// sizes before the `parquet` crate allocates them.
+/// Walks the page headers of a column chunk of `len` bytes at `start` (in a file of `size`
+/// bytes, read by `chunk`), checking each page's sizes before the `parquet` crate
+/// allocates them.
 fn check_pages(
     file: &str,
-    bytes: &[u8],
+    size: u64,
+    chunk: &ChunkFn<'_>,
     name: &str,
     start: i64,
     len: i64,
@@ -263,19 +301,21 @@ fn check_pages(
     };
     let end = start
         .checked_add(len)
-        .filter(|&e| e <= bytes.len() as u64)
+        .filter(|&e| e <= size)
         .ok_or_else(|| {
             bad(
                 start,
                 format!("a column chunk of {len} bytes"),
-                format!("one within the file's {} bytes", bytes.len()),
+                format!("one within the file's {size} bytes"),
             )
         })?;
+    // the chunk's bytes; positions below stay file offsets
+    let bytes = chunk(start, len)?;
     let mut pos = start;
     while pos < end {
         let mut t = Thrift {
-            b: &bytes[..end as usize],
-            i: pos as usize,
+            b: &bytes,
+            i: (pos - start) as usize,
         };
         let (unc, comp) = t.page_header().ok_or_else(|| {
             bad(
@@ -291,7 +331,7 @@ fn check_pages(
                 "non-negative sizes".into(),
             ));
         };
-        let data = t.i as u64;
+        let data = start + t.i as u64;
         if comp > end - data {
             return Err(bad(
                 pos,

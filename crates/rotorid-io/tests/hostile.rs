@@ -152,3 +152,38 @@ fn huge_length_fields_never_allocate() {
         }
     }
 }
+
+#[test]
+fn parquet_read_from_disk_refuses_what_the_bytes_reader_refuses() {
+    // `read_table` reads a Parquet file column chunk by column chunk from disk
+    // (`parquet::read_file`); it must accept and refuse exactly what the in-memory reader
+    // does, with the same message
+    let dir = tempfile::tempdir().unwrap();
+    for (path, format, bytes) in fixtures() {
+        if format != Format::Parquet {
+            continue;
+        }
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let on_disk = dir.path().join(&name);
+        let on_disk_name = on_disk.display().to_string();
+        let mut variants: Vec<Vec<u8>> = cuts(bytes.len()).map(|c| bytes[..c].to_vec()).collect();
+        let step = (bytes.len() / 100).max(1);
+        for i in (0..bytes.len()).step_by(step) {
+            let mut b = bytes.clone();
+            b[i] ^= 0xff;
+            variants.push(b);
+        }
+        variants.push(bytes.clone());
+        for b in variants {
+            let len = b.len();
+            std::fs::write(&on_disk, &b).unwrap();
+            let mem = read_bytes(format, &on_disk_name, &b);
+            let disk = rotorid_io::read_table(&on_disk);
+            match (mem, disk) {
+                (Ok(a), Ok(b)) => assert_eq!(a, b, "{name}"),
+                (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{name}"),
+                (a, b) => panic!("{name} ({len} bytes): in memory {a:?}, from disk {b:?}"),
+            }
+        }
+    }
+}
