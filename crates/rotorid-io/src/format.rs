@@ -68,8 +68,11 @@ pub fn read_table(path: impl AsRef<Path>) -> Result<Table, ReadError> {
         return crate::csv::read_csv_table(&file, std::io::BufReader::with_capacity(1 << 16, f))
             .map_err(|e| ReadError::Csv(Box::new(e)));
     }
-    if format == Format::Parquet {
-        return crate::parquet::read_file(&file, path);
+    match format {
+        Format::Parquet => return crate::parquet::read_file(&file, path),
+        Format::Npz => return crate::npz::read_file(&file, path),
+        Format::Mat => return crate::mat::read_file(&file, path),
+        _ => {}
     }
     let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
         file: file.clone(),

@@ -23,13 +23,34 @@ const MAX_DEFLATE_RATIO: u64 = 1032;
 
 /// Reads an `.npz` file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
+    read_from(file, std::io::Cursor::new(bytes), bytes.len() as u64)
+}
+
+/// Reads the `.npz` file at `path` member by member: memory holds the channels and one
+/// member, never the whole file.
+pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
+    let io = |source| ReadError::Io {
+        file: file.to_string(),
+        source,
+    };
+    let f = std::fs::File::open(path).map_err(io)?;
+    let size = f.metadata().map_err(io)?.len();
+    read_from(file, std::io::BufReader::new(f), size)
+}
+
+/// The table of the archive `input` of `size` bytes.
+fn read_from<R: Read + std::io::Seek>(
+    file: &str,
+    input: R,
+    size_of_file: u64,
+) -> Result<Table, ReadError> {
     let zerr = |channel: Option<&str>, e: zip::result::ZipError| ReadError::Container {
         file: file.to_string(),
         channel: channel.map(str::to_string),
         container: "zip",
         message: e.to_string(),
     };
-    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).map_err(|e| zerr(None, e))?;
+    let mut zip = zip::ZipArchive::new(input).map_err(|e| zerr(None, e))?;
     let mut channels = Vec::new();
     for i in 0..zip.len() {
         let mut member = zip.by_index(i).map_err(|e| zerr(None, e))?;
@@ -55,14 +76,15 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
                 })
             }
         };
-        if size > limit || packed > bytes.len() as u64 {
+        let file_size = size_of_file;
+        if size > limit || packed > file_size {
             return Err(ReadError::Invalid {
                 file: file.to_string(),
                 channel: Some(name),
                 offset: at,
                 what: "zip member size".into(),
                 found: format!("{size} bytes uncompressed from {packed} compressed"),
-                allowed: format!("at most {limit} (the file is {} bytes)", bytes.len()),
+                allowed: format!("at most {limit} (the file is {file_size} bytes)"),
             });
         }
         let mut buf = Vec::with_capacity(size as usize);

@@ -154,13 +154,13 @@ fn huge_length_fields_never_allocate() {
 }
 
 #[test]
-fn parquet_read_from_disk_refuses_what_the_bytes_reader_refuses() {
-    // `read_table` reads a Parquet file column chunk by column chunk from disk
-    // (`parquet::read_file`); it must accept and refuse exactly what the in-memory reader
-    // does, with the same message
+fn reading_from_disk_refuses_what_the_bytes_reader_refuses() {
+    // `read_table` reads Parquet column chunk by column chunk, NPZ member by member and
+    // MAT level 5 element by element from disk (`*::read_file`); it must accept and
+    // refuse exactly what the in-memory readers do, with the same messages
     let dir = tempfile::tempdir().unwrap();
     for (path, format, bytes) in fixtures() {
-        if format != Format::Parquet {
+        if !matches!(format, Format::Parquet | Format::Npz | Format::Mat) {
             continue;
         }
         let name = path.file_name().unwrap().to_string_lossy().to_string();

@@ -30,3 +30,29 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
     }
     v5::read(file, bytes)
 }
+
+/// Reads the `.mat` file at `path`: level 5 element by element ([`v5::read_file`]: memory
+/// holds the channels and one variable), v7.3 whole.
+pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
+    use std::io::Read as _;
+    let io = |source| ReadError::Io {
+        file: file.to_string(),
+        source,
+    };
+    let mut head = Vec::with_capacity(520);
+    std::fs::File::open(path)
+        .map_err(io)?
+        .take(520)
+        .read_to_end(&mut head)
+        .map_err(io)?;
+    let v73 = head.len() >= 128
+        && head.starts_with(b"MATLAB")
+        && ([head[124], head[125]] == [0x00, 0x02]
+            || [head[124], head[125]] == [0x02, 0x00]
+            || head.get(512..520) == Some(b"\x89HDF\r\n\x1a\n".as_slice()));
+    if v73 {
+        let bytes = std::fs::read(path).map_err(io)?;
+        return v73::read(file, &bytes);
+    }
+    v5::read_file(file, path)
+}

@@ -44,6 +44,74 @@ const MAX_DEFLATE_RATIO: u64 = 1032;
 /// Reads a level 5 MAT-file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
     let mut c = Cursor::new(file, bytes);
+    let endian = header(&mut c)?;
+    let mut channels = Vec::new();
+    let mut skipped = Vec::new();
+    while !c.at_end() {
+        element(&mut c, endian, &mut channels, &mut skipped)?;
+    }
+    finish(file, channels, skipped)
+}
+
+/// Reads the level 5 file at `path` element by element: memory holds the channels and one
+/// top-level element (one variable), never the whole file. Accepts and refuses what
+/// [`read`] does, with the same messages.
+pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
+    use std::os::unix::fs::FileExt as _;
+    let io = |source| ReadError::Io {
+        file: file.to_string(),
+        source,
+    };
+    let f = std::fs::File::open(path).map_err(io)?;
+    let size = f.metadata().map_err(io)?.len();
+    let read_at = |at: u64, len: u64| -> Result<Vec<u8>, ReadError> {
+        let mut buf = vec![0u8; len as usize];
+        f.read_exact_at(&mut buf, at).map_err(io)?;
+        Ok(buf)
+    };
+    let head = read_at(0, size.min(128))?;
+    let endian = header(&mut Cursor::new(file, &head))?;
+    let mut channels = Vec::new();
+    let mut skipped = Vec::new();
+    let mut pos = 128u64;
+    while pos < size {
+        // the element's extent from its tag, as `tag` reads it (a truncated element is
+        // read to the end of the file, where `tag` refuses it as it would in memory)
+        let t = read_at(pos, (size - pos).min(8))?;
+        let word = |i: usize| {
+            let b: [u8; 4] = t[i..i + 4].try_into().expect("four bytes");
+            match endian {
+                Endian::Little => u32::from_le_bytes(b),
+                Endian::Big => u32::from_be_bytes(b),
+            }
+        };
+        let total = if t.len() < 8 || word(0) >> 16 != 0 {
+            8
+        } else {
+            let n = u64::from(word(4));
+            let pad = if word(0) == MI_COMPRESSED {
+                0
+            } else {
+                (8 - n % 8) % 8
+            };
+            8 + n + pad
+        };
+        let len = total.min(size - pos);
+        let buf = read_at(pos, len)?;
+        let mut c = Cursor {
+            base: pos,
+            ..Cursor::new(file, &buf)
+        };
+        while !c.at_end() {
+            element(&mut c, endian, &mut channels, &mut skipped)?;
+        }
+        pos += len;
+    }
+    finish(file, channels, skipped)
+}
+
+/// Reads the 128-byte header: the byte order of the rest.
+fn header(c: &mut Cursor) -> Result<Endian, ReadError> {
     let text = c.take(116, "MAT header text")?;
     if !text.starts_with(b"MATLAB") {
         return Err(c.invalid_at(
@@ -74,31 +142,46 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
     if v != 0x0100 {
         return Err(c.invalid_at(124, "MAT version", format!("{v:#06x}"), "0x0100 (level 5)"));
     }
-    let mut channels = Vec::new();
-    let mut skipped = Vec::new();
-    while !c.at_end() {
-        let el = tag(&mut c, endian)?;
-        match el.ty {
-            MI_MATRIX => {
-                let mut sub = el.cursor(&c);
-                let var = matrix(&mut sub, endian, 0, None)?;
-                collect(var, &mut channels, &mut skipped);
-            }
-            MI_COMPRESSED => {
-                let inflated = inflate(&c, &el)?;
-                let mut ic = Cursor::inflated(file, &inflated, c.offset_of(el.at));
-                let inner = tag(&mut ic, endian)?;
-                if inner.ty == MI_MATRIX {
-                    let mut sub = inner.cursor(&ic);
-                    let var = matrix(&mut sub, endian, 0, None)?;
-                    collect(var, &mut channels, &mut skipped);
-                } else {
-                    skipped.push(format!("a compressed element of type {}", inner.ty));
-                }
-            }
-            t => skipped.push(format!("a top-level element of type {t} at byte {}", el.at)),
+    Ok(endian)
+}
+
+/// Reads one top-level element at `c` into `channels` (or a note in `skipped`).
+fn element(
+    c: &mut Cursor,
+    endian: Endian,
+    channels: &mut Vec<Channel>,
+    skipped: &mut Vec<String>,
+) -> Result<(), ReadError> {
+    let file = c.file;
+    let el = tag(c, endian)?;
+    match el.ty {
+        MI_MATRIX => {
+            let mut sub = el.cursor(c);
+            let var = matrix(&mut sub, endian, 0, None)?;
+            collect(var, channels, skipped);
         }
+        MI_COMPRESSED => {
+            let inflated = inflate(c, &el)?;
+            let mut ic = Cursor::inflated(file, &inflated, c.offset_of(el.at));
+            let inner = tag(&mut ic, endian)?;
+            if inner.ty == MI_MATRIX {
+                let mut sub = inner.cursor(&ic);
+                let var = matrix(&mut sub, endian, 0, None)?;
+                collect(var, channels, skipped);
+            } else {
+                skipped.push(format!("a compressed element of type {}", inner.ty));
+            }
+        }
+        t => skipped.push(format!(
+            "a top-level element of type {t} at byte {}",
+            c.offset_of(el.at)
+        )),
     }
+    Ok(())
+}
+
+/// The table of what was read, or the error that nothing was.
+fn finish(file: &str, channels: Vec<Channel>, skipped: Vec<String>) -> Result<Table, ReadError> {
     if channels.is_empty() {
         return Err(ReadError::NoChannels {
             file: file.to_string(),
