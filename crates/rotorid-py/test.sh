@@ -8,7 +8,8 @@
 #   crates/rotorid-py/test.sh [pytest arguments]
 #
 # Environment: CARGO_TARGET_DIR (default <repo>/target) holds the build and the venv
-# (ROTORID_VENV overrides its path); PYTHON picks the interpreter (default python3).
+# (ROTORID_VENV overrides its path); PYTHON picks the interpreter (default python3);
+# ROTORID_BIN names a `rotorid` binary to use instead of building one.
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -36,11 +37,14 @@ echo "== building and installing the package (pip install crates/rotorid-py)"
 MATURIN_PEP517_ARGS="${MATURIN_PEP517_ARGS:---profile dev}" CARGO_TARGET_DIR="$target" \
     "$py" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps "$here"
 
-# the dev profile (dependencies optimised, see Cargo.toml): after `cargo test --workspace`
-# it is already built, where a release build would compile every dependency again
-echo "== building the rotorid command (parity tests)"
-(cd "$root" && CARGO_TARGET_DIR="$target" cargo build --quiet -p rotorid-cli)
-export ROTORID_BIN="$target/debug/rotorid"
+# ROTORID_BIN set by the caller (.ci/test: the binary `cargo test --workspace` just built
+# for its own end-to-end tests) is used as it is; else it is built here, dev profile
+if [ -z "${ROTORID_BIN:-}" ]; then
+    echo "== building the rotorid command (parity tests)"
+    (cd "$root" && CARGO_TARGET_DIR="$target" cargo build --quiet -p rotorid-cli)
+    export ROTORID_BIN="$target/debug/rotorid"
+fi
+echo "== the rotorid command of the parity tests: $ROTORID_BIN"
 
 echo "== pytest"
 cd "$here"

@@ -21,6 +21,8 @@ pub mod publish;
 pub mod result;
 #[cfg(feature = "nats")]
 pub mod status;
+#[cfg(feature = "test-server")]
+pub mod test_server;
 pub mod window;
 #[cfg(feature = "nats")]
 pub mod worker;

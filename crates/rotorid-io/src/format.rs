@@ -96,3 +96,42 @@ pub fn read_bytes(format: Format, file: &str, bytes: &[u8]) -> Result<Table, Rea
         }
     }
 }
+
+/// A file opened for reading at offsets, with its size; errors name `file`.
+pub(crate) struct DiskFile<'a> {
+    file: &'a str,
+    f: std::fs::File,
+    /// Size \[bytes\].
+    pub size: u64,
+}
+
+impl<'a> DiskFile<'a> {
+    /// Opens `path`; `file` names it in errors.
+    pub fn open(file: &'a str, path: &Path) -> Result<Self, ReadError> {
+        let f = std::fs::File::open(path).map_err(|e| Self::io(file, e))?;
+        let size = f.metadata().map_err(|e| Self::io(file, e))?.len();
+        Ok(Self { file, f, size })
+    }
+
+    fn io(file: &str, source: std::io::Error) -> ReadError {
+        ReadError::Io {
+            file: file.to_string(),
+            source,
+        }
+    }
+
+    /// The bytes `[at, at + len)` (the caller keeps them within the size).
+    pub fn read_at(&self, at: u64, len: u64) -> Result<Vec<u8>, ReadError> {
+        use std::os::unix::fs::FileExt as _;
+        let mut buf = vec![0u8; len as usize];
+        self.f
+            .read_exact_at(&mut buf, at)
+            .map_err(|e| Self::io(self.file, e))?;
+        Ok(buf)
+    }
+
+    /// A second handle on the file (for readers that take ownership).
+    pub fn handle(&self) -> Result<std::fs::File, ReadError> {
+        self.f.try_clone().map_err(|e| Self::io(self.file, e))
+    }
+}

@@ -29,13 +29,8 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 /// Reads the `.npz` file at `path` member by member: memory holds the channels and one
 /// member, never the whole file.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
-    let io = |source| ReadError::Io {
-        file: file.to_string(),
-        source,
-    };
-    let f = std::fs::File::open(path).map_err(io)?;
-    let size = f.metadata().map_err(io)?.len();
-    read_from(file, std::io::BufReader::new(f), size)
+    let disk = crate::format::DiskFile::open(file, path)?;
+    read_from(file, std::io::BufReader::new(disk.handle()?), disk.size)
 }
 
 /// The table of the archive `input` of `size` bytes.

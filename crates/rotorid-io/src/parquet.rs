@@ -39,20 +39,10 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 /// Reads the Parquet file at `path` column chunk by column chunk: memory holds the channels
 /// and one column chunk (and the `parquet` crate's page buffers), never the whole file.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
-    use std::os::unix::fs::FileExt as _;
-    let io = |source| ReadError::Io {
-        file: file.to_string(),
-        source,
-    };
-    let f = std::fs::File::open(path).map_err(io)?;
-    let size = f.metadata().map_err(io)?.len();
-    let g = f.try_clone().map_err(io)?;
-    let chunk = move |start: u64, len: u64| {
-        let mut buf = vec![0u8; len as usize];
-        g.read_exact_at(&mut buf, start).map_err(io)?;
-        Ok(buf)
-    };
-    guarded(file, || read_inner(file, f, size, &chunk))
+    let disk = crate::format::DiskFile::open(file, path)?;
+    let handle = disk.handle()?;
+    let chunk = |start: u64, len: u64| disk.read_at(start, len);
+    guarded(file, || read_inner(file, handle, disk.size, &chunk))
 }
 
 /// `run`, with a panic of the third-party parser on a hostile file made an error.

@@ -4,6 +4,7 @@ mod common;
 
 mod analysis;
 mod demo;
+mod fleet;
 mod formats;
 mod golden;
 mod identify;

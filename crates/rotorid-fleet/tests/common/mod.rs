@@ -3,101 +3,15 @@
 
 #![allow(dead_code)]
 
-use std::net::TcpStream;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
 
 use rotorid::model::{InitialState, Rotor, RotorParams, Sampling, Scenario};
 use rotorid::simulate::{add_noise, simulate, Method as Simulation, TimeResponse};
 use rotorid::SpeedProfile;
 use rotorid_fleet::Channel;
 
-/// A nats-server of our own.
-pub struct Server {
-    pub port: u16,
-    dir: PathBuf,
-    child: Option<Child>,
-}
-
-/// `$NATS_SERVER`, else `nats-server` on the PATH, else the Debian package's.
-fn nats_server() -> PathBuf {
-    if let Some(p) = std::env::var_os("NATS_SERVER") {
-        return p.into();
-    }
-    let on_path = std::env::var_os("PATH")
-        .is_some_and(|p| std::env::split_paths(&p).any(|d| d.join("nats-server").is_file()));
-    if on_path {
-        "nats-server".into()
-    } else {
-        "/usr/sbin/nats-server".into()
-    }
-}
-
-fn free_port() -> u16 {
-    let l = std::net::TcpListener::bind("127.0.0.1:0").expect("a free loopback port");
-    l.local_addr().expect("its address").port()
-}
-
-impl Server {
-    /// Start `nats-server -js -sd DIR` on a free port of 127.0.0.1.
-    pub fn start(dir: &Path) -> Self {
-        let mut s = Self {
-            port: free_port(),
-            dir: dir.to_owned(),
-            child: None,
-        };
-        s.spawn();
-        s
-    }
-
-    fn spawn(&mut self) {
-        let child = Command::new(nats_server())
-            .args(["-js", "-a", "127.0.0.1", "-p"])
-            .arg(self.port.to_string())
-            .arg("-sd")
-            .arg(&self.dir)
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect(
-                "nats-server is not installed: `apt-get install -y nats-server` (.ci/test \
-                 does it)",
-            );
-        self.child = Some(child);
-        let t = Instant::now();
-        while TcpStream::connect(("127.0.0.1", self.port)).is_err() {
-            assert!(
-                t.elapsed() < Duration::from_secs(20),
-                "nats-server did not start"
-            );
-            std::thread::sleep(Duration::from_millis(50));
-        }
-    }
-
-    pub fn url(&self) -> String {
-        format!("nats://127.0.0.1:{}", self.port)
-    }
-
-    /// SIGKILL the server and start it again on the same port and store.
-    pub fn restart(&mut self) {
-        self.kill();
-        self.spawn();
-    }
-
-    fn kill(&mut self) {
-        if let Some(mut c) = self.child.take() {
-            let _ = c.kill();
-            let _ = c.wait();
-        }
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        self.kill();
-    }
-}
+pub use rotorid_fleet::test_server::Server;
 
 /// Machine `i`'s rotor: table1 with kx, kz, cx, cz varied by a few per cent.
 pub fn rotor(i: usize) -> RotorParams {

@@ -57,18 +57,8 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 /// top-level element (one variable), never the whole file. Accepts and refuses what
 /// [`read`] does, with the same messages.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
-    use std::os::unix::fs::FileExt as _;
-    let io = |source| ReadError::Io {
-        file: file.to_string(),
-        source,
-    };
-    let f = std::fs::File::open(path).map_err(io)?;
-    let size = f.metadata().map_err(io)?.len();
-    let read_at = |at: u64, len: u64| -> Result<Vec<u8>, ReadError> {
-        let mut buf = vec![0u8; len as usize];
-        f.read_exact_at(&mut buf, at).map_err(io)?;
-        Ok(buf)
-    };
+    let disk = crate::format::DiskFile::open(file, path)?;
+    let (size, read_at) = (disk.size, |at, len| disk.read_at(at, len));
     let head = read_at(0, size.min(128))?;
     let endian = header(&mut Cursor::new(file, &head))?;
     let mut channels = Vec::new();

@@ -252,17 +252,26 @@ fn read_all<R: Read>(
 ) -> anyhow::Result<()> {
     let mut reader = open_rows(io, input, profile)?;
     while let Some(row) = reader.next_row()? {
-        let s = Sample {
-            t: Some(row.t),
-            x: row.x,
-            z: row.z,
-            speed: row.speed,
-        };
-        push(io, state, &s, |m| {
-            CsvError::line(io.name, row.line, m).into()
-        })?;
+        push_row(io, state, &row)?;
     }
     Ok(())
+}
+
+/// One row of the response CSV into the session (a refusal names its line).
+fn push_row(
+    io: &Io,
+    state: &Rc<RefCell<State>>,
+    row: &crate::io::response_csv::ResponseRow,
+) -> anyhow::Result<()> {
+    let s = Sample {
+        t: Some(row.t),
+        x: row.x,
+        z: row.z,
+        speed: row.speed,
+    };
+    push(io, state, &s, |m| {
+        CsvError::line(io.name, row.line, m).into()
+    })
 }
 
 /// The response CSV reader of `input`, its unit conversions noted on stderr; an error when
@@ -328,15 +337,7 @@ fn read_all_threaded(
         // rx is dropped on the first error, which stops the reader at its next send
         for batch in rx {
             for row in batch? {
-                let s = Sample {
-                    t: Some(row.t),
-                    x: row.x,
-                    z: row.z,
-                    speed: row.speed,
-                };
-                push(io, state, &s, |m| {
-                    CsvError::line(io.name, row.line, m).into()
-                })?;
+                push_row(io, state, &row)?;
             }
         }
         Ok(())

@@ -1,0 +1,182 @@
+//! `rotorid publish`, `rotorid worker` and `rotorid fleet status` against a real
+//! nats-server (JetStream, its own store and port; `.ci/test` installs the Debian package):
+//! a recording published in windows is identified by a worker process, the status lists
+//! every window with estimates that agree with the truth, the same estimates offline
+//! `rotorid identify` gives on each window's samples, and SIGTERM stops the worker cleanly.
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use rotorid_fleet::test_server::Server;
+
+use crate::common::rotorid;
+
+fn run(args: &[&str]) -> String {
+    let out = rotorid().args(args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "rotorid {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// The status's estimate lines of one machine: parameter -> (value, standard error).
+fn estimates(status: &str) -> Vec<(String, f64, f64)> {
+    status
+        .lines()
+        .filter_map(|l| {
+            let (name, rest) = l.trim().split_once(" = ")?;
+            let (v, rest) = rest.split_once(" +- ")?;
+            let e = rest.split_whitespace().next()?;
+            Some((name.trim().to_owned(), v.parse().ok()?, e.parse().ok()?))
+        })
+        .collect()
+}
+
+#[test]
+fn a_recording_published_in_windows_is_identified_by_a_worker() {
+    let dir = tempfile::tempdir().unwrap();
+    let server = Server::start(&dir.path().join("js"));
+    let url = server.url();
+    let rec = dir.path().join("r.csv");
+    let rec = rec.to_str().unwrap();
+    run(&[
+        "simulate",
+        "--scenario",
+        "table1",
+        "--duration",
+        "3",
+        "--snr-db",
+        "40",
+        "--seed",
+        "11",
+        "--out",
+        rec,
+        "-q",
+    ]);
+    run(&[
+        "publish",
+        rec,
+        "--nats",
+        &url,
+        "--machine",
+        "rig-1",
+        "--window-s",
+        "1",
+    ]);
+    let worker = Command::new(assert_cmd::cargo::cargo_bin("rotorid"))
+        .args([
+            "worker",
+            "--nats",
+            &url,
+            "--scenario",
+            "table1",
+            "--method",
+            "refine",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t = Instant::now();
+    let status = loop {
+        let s = run(&["fleet", "status", "--nats", &url]);
+        let done = s.lines().any(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            f.first() == Some(&"rig-1") && f.get(2) == Some(&"3")
+        });
+        if done {
+            break s;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(120),
+            "not identified:\n{s}"
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    };
+    // SIGTERM: the worker finishes its window and exits 0
+    let pid = worker.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let out = worker.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "worker: {:?}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(status.contains("window 2"), "{status}");
+    // the latest window (2 s to 3 s) as offline identify gives it on the same samples
+    let text = std::fs::read_to_string(rec).unwrap();
+    let mut lines = text.lines();
+    let mut window = vec![lines.next().unwrap().to_owned()];
+    window.extend(lines.skip(20_000).map(str::to_owned)); // the 30 001st sample joins it
+    let last = dir.path().join("w2.csv");
+    std::fs::write(&last, window.join("\n") + "\n").unwrap();
+    let sum = dir.path().join("w2.json");
+    run(&[
+        "identify",
+        last.to_str().unwrap(),
+        "--scenario",
+        "table1",
+        "--method",
+        "refine",
+        "--out",
+        dir.path().join("e.csv").to_str().unwrap(),
+        "--summary",
+        sum.to_str().unwrap(),
+        "-q",
+    ]);
+    let offline: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&sum).unwrap()).unwrap();
+    let got = estimates(&status);
+    assert_eq!(got.len(), 5, "{status}");
+    for (name, v, e) in got {
+        let p = offline["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["parameter"] == name.as_str())
+            .unwrap_or_else(|| panic!("{name} not in the offline summary"));
+        let (ov, oe, truth) = (
+            p["value"].as_f64().unwrap(),
+            p["std_error"].as_f64().unwrap(),
+            p["truth"].as_f64().unwrap(),
+        );
+        // the status prints 7 significant digits and 3 of the error
+        assert!(
+            (v - ov).abs() <= 1e-6 * ov.abs(),
+            "{name}: {v} vs offline {ov}"
+        );
+        assert!(
+            (e - oe).abs() <= 1e-2 * oe,
+            "{name}: +- {e} vs offline {oe}"
+        );
+        assert!(
+            (v - truth).abs() < 5.0 * e,
+            "{name}: {v} +- {e}, truth {truth}"
+        );
+    }
+}
+
+#[test]
+fn publish_refuses_a_machine_id_that_is_not_a_subject_token() {
+    let out = rotorid()
+        .args([
+            "publish",
+            "whatever.csv",
+            "--nats",
+            "nats://127.0.0.1:1",
+            "--machine",
+            "rig 1.a",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("rig 1.a"), "{err}");
+}
