@@ -88,6 +88,9 @@ fn read_recording(file: &str) -> anyhow::Result<(TimeGrid, Vec<Channel>)> {
 
 /// Run `rotorid publish`.
 pub fn run(args: PublishArgs) -> anyhow::Result<()> {
+    // the arguments first: a bad id is refused before the recording is read
+    rotorid_fleet::frame::check_machine_id(&args.machine)
+        .map_err(|e| anyhow::anyhow!("--machine {:?}: {e}", args.machine))?;
     if !(args.window_s.is_finite() && args.window_s > 0.0) {
         anyhow::bail!(
             "--window-s = {} is out of range: must be finite and > 0 (s)",

@@ -178,5 +178,8 @@ fn publish_refuses_a_machine_id_that_is_not_a_subject_token() {
         .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("rig 1.a"), "{err}");
+    assert!(
+        err.contains("--machine \"rig 1.a\"") && err.contains("letters, digits"),
+        "{err}"
+    );
 }
