@@ -182,6 +182,21 @@ fn response_table(file: &str, r: TimeResponse) -> rotorid_io::Table {
     }
 }
 
+/// White noise at `snr_db` (seed `--seed`, default 0) added to `resp`, said on stderr
+/// unless `-q`.
+fn noisy(args: &SimulateArgs, resp: &mut TimeResponse, snr_db: f64) -> anyhow::Result<()> {
+    let seed = args.seed.unwrap_or(0);
+    let level = add_noise(resp, snr_db, seed)?;
+    if !args.quiet {
+        eprintln!(
+            "added white noise at SNR {snr_db} dB (seed {seed}): sigma_x = {:e} m, \
+             sigma_z = {:e} m",
+            level.sigma_x, level.sigma_z
+        );
+    }
+    Ok(())
+}
+
 /// `--out` in a binary format: the whole response, then the file.
 fn write_table_file(
     args: &SimulateArgs,
@@ -190,15 +205,7 @@ fn write_table_file(
 ) -> anyhow::Result<()> {
     let mut resp = rotorid::simulate::simulate(scenario, method)?;
     if let Some(snr_db) = args.snr_db {
-        let seed = args.seed.unwrap_or(0);
-        let level = add_noise(&mut resp, snr_db, seed)?;
-        if !args.quiet {
-            eprintln!(
-                "added white noise at SNR {snr_db} dB (seed {seed}): sigma_x = {:e} m, \
-                 sigma_z = {:e} m",
-                level.sigma_x, level.sigma_z
-            );
-        }
+        noisy(args, &mut resp, snr_db)?;
     }
     rotorid_io::write_table(&args.out, &response_table(&args.out, resp))?;
     Ok(())
@@ -306,15 +313,7 @@ fn write_response(
                 resp.push(&integ.step()?);
                 progress.update(i as u64);
             }
-            let seed = args.seed.unwrap_or(0);
-            let level = add_noise(&mut resp, snr_db, seed)?;
-            if !args.quiet {
-                eprintln!(
-                    "added white noise at SNR {snr_db} dB (seed {seed}): sigma_x = {:e} m, \
-                     sigma_z = {:e} m",
-                    level.sigma_x, level.sigma_z
-                );
-            }
+            noisy(args, &mut resp, snr_db)?;
             for i in 0..resp.len() {
                 let speed = rotorid::SpeedState {
                     phi: resp.phi[i],

@@ -38,15 +38,8 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
         let mut skipped = Vec::new();
         for name in root.datasets().map_err(|e| err(file, None, e))? {
             let ds = root.dataset(&name).map_err(|e| err(file, Some(&name), e))?;
-            match vector(file, &name, &ds, limit)? {
-                Ok(data) => channels.push(Channel {
-                    name,
-                    unit: None,
-                    data,
-                    axis: None,
-                }),
-                Err(why) => skipped.push(format!("{name}: {why}")),
-            }
+            let v = vector(file, &name, &ds, limit)?;
+            keep(name, v, &mut channels, &mut skipped);
         }
         for gname in root.groups().map_err(|e| err(file, None, e))? {
             if gname.starts_with('#') {
@@ -65,15 +58,8 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
             for f in g.datasets().map_err(|e| err(file, Some(&gname), e))? {
                 let name = format!("{gname}.{f}");
                 let ds = g.dataset(&f).map_err(|e| err(file, Some(&name), e))?;
-                match vector(file, &name, &ds, limit)? {
-                    Ok(data) => channels.push(Channel {
-                        name,
-                        unit: None,
-                        data,
-                        axis: None,
-                    }),
-                    Err(why) => skipped.push(format!("{name}: {why}")),
-                }
+                let v = vector(file, &name, &ds, limit)?;
+                keep(name, v, &mut channels, &mut skipped);
             }
         }
         if channels.is_empty() {
@@ -256,4 +242,22 @@ fn vector(
         });
     }
     Ok(Ok(data))
+}
+
+/// A variable read as a vector becomes channel `name`; one that is not, a line of `skipped`.
+fn keep(
+    name: String,
+    vector: Result<Vec<f64>, String>,
+    channels: &mut Vec<Channel>,
+    skipped: &mut Vec<String>,
+) {
+    match vector {
+        Ok(data) => channels.push(Channel {
+            name,
+            unit: None,
+            data,
+            axis: None,
+        }),
+        Err(why) => skipped.push(format!("{name}: {why}")),
+    }
 }
