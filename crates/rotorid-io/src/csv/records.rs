@@ -66,6 +66,39 @@ impl<'a> Record<'a> {
     }
 }
 
+/// A record as [`RecordReader::next_raw`] gives it.
+#[derive(Debug)]
+pub enum RawRecord<'a> {
+    /// A line without a quote, its line end excluded, not yet split or trimmed.
+    Line {
+        /// The line's bytes.
+        text: &'a [u8],
+        /// Its number (1-based).
+        line: u64,
+    },
+    /// A record with a quoted field, unescaped and split.
+    Quoted(Record<'a>),
+}
+
+/// The fields of a plain line of [`RawRecord::Line`], split and trimmed exactly as
+/// [`RecordReader::next_record`] splits it; `fields` is scratch space reused from call to call.
+pub fn split_line<'a>(text: &'a [u8], line: u64, fields: &'a mut Vec<Range<usize>>) -> Record<'a> {
+    split(text, 0, fields);
+    Record {
+        data: text,
+        fields,
+        line,
+    }
+}
+
+/// Where [`RecordReader::scan`] found the next record.
+enum Scan {
+    /// `buf[start..start + len]`, a line without a quote (already consumed).
+    Plain { start: usize, len: usize, line: u64 },
+    /// A line with a quote, from `pos`.
+    Quoted { line: u64 },
+}
+
 /// An I/O error met while reading records, and the line being read then.
 #[derive(Debug)]
 pub struct ReadError {
@@ -135,6 +168,38 @@ impl<R: Read> RecordReader<R> {
     /// it came (a line over the cap as an `InvalidData` error carrying [`LineTooLong`]),
     /// with the line being read.
     pub fn next_record(&mut self) -> Result<Option<Record<'_>>, ReadError> {
+        match self.scan()? {
+            None => Ok(None),
+            Some(Scan::Quoted { line }) => self.quoted_record(line),
+            Some(Scan::Plain { start, len, line }) => {
+                split(&self.buf[start..start + len], start, &mut self.fields);
+                Ok(Some(Record {
+                    data: &self.buf,
+                    fields: &self.fields,
+                    line,
+                }))
+            }
+        }
+    }
+
+    /// The next record as [`next_record`](Self::next_record) reads it, but a line without
+    /// a quote comes unsplit ([`RawRecord::Line`]: a reader that knows its columns may
+    /// parse it in one pass, and [`split_line`] splits it as `next_record` would).
+    pub fn next_raw(&mut self) -> Result<Option<RawRecord<'_>>, ReadError> {
+        match self.scan()? {
+            None => Ok(None),
+            Some(Scan::Quoted { line }) => Ok(self.quoted_record(line)?.map(RawRecord::Quoted)),
+            Some(Scan::Plain { start, len, line }) => Ok(Some(RawRecord::Line {
+                text: &self.buf[start..start + len],
+                line,
+            })),
+        }
+    }
+
+    /// Skip blank lines, then find the next record's extent: a plain line (consumed with
+    /// its line end) or a line with a quote (left for [`Self::quoted_record`]).
+    #[inline]
+    fn scan(&mut self) -> Result<Option<Scan>, ReadError> {
         // blank lines
         loop {
             if self.pos == self.end && !self.fill()? {
@@ -174,22 +239,18 @@ impl<R: Read> RecordReader<R> {
         };
         let len = stop.unwrap_or(self.end - self.pos);
         if stop.is_some_and(|i| self.buf[self.pos + i] == b'"') {
-            return self.quoted_record(line);
+            return Ok(Some(Scan::Quoted { line }));
         }
         if len > self.cap {
             return Err(self.too_long());
         }
         let start = self.pos;
-        split(&self.buf[start..start + len], start, &mut self.fields);
         self.pos += len;
         if self.pos < self.end {
+            // (consuming a line end never moves the buffer: `start` stays valid)
             self.line_end();
         }
-        Ok(Some(Record {
-            data: &self.buf,
-            fields: &self.fields,
-            line,
-        }))
+        Ok(Some(Scan::Plain { start, len, line }))
     }
 
     /// Consume the line end at `pos` (LF, CR or CRLF).

@@ -32,9 +32,15 @@
 
 use std::io::Read;
 
-use super::columns::{check_length, csv_reader, finite_field, next_record, CsvReader, Header};
+use std::ops::Range;
+
+use super::columns::{
+    check_length, csv_reader, finite_field, io_error, next_record, CsvReader, Header,
+    MAX_FIELD_BYTES,
+};
 use super::error::CsvError;
 use super::number::{format_f64, readable};
+use super::records::{split_line, RawRecord};
 use crate::units::{Conversion, Quantity};
 
 /// The header `rotorid simulate` writes.
@@ -86,7 +92,16 @@ pub struct ResponseReader<R: Read> {
     phi: Option<[usize; 3]>,
     /// The conversion to SI of t, x, z, phi, phi_dot, phi_ddot.
     conv: [Conversion; 6],
+    /// Per column, the index in t, x, z, phi, phi_dot, phi_ddot it plays, or [`UNUSED`].
+    roles: Vec<u8>,
+    /// Scratch fields of a line split for the general path.
+    fields: Vec<Range<usize>>,
+    /// Try the one-pass parse first (off only in tests, to compare both paths).
+    fast: bool,
 }
+
+/// The role of a column the reader does not use ([`ResponseReader`]'s `roles`).
+const UNUSED: u8 = u8::MAX;
 
 impl<R: Read> ResponseReader<R> {
     /// Read and check the header of `input`; `file` names it in messages.
@@ -137,6 +152,10 @@ impl<R: Read> ResponseReader<R> {
         {
             *c = header.conversion(file, col, name, q)?;
         }
+        let mut roles = vec![UNUSED; header.names.len()];
+        for (role, &col) in txz.iter().chain(phi.iter().flatten()).enumerate() {
+            roles[col] = role as u8;
+        }
         Ok(Self {
             file: file.to_owned(),
             csv,
@@ -144,6 +163,9 @@ impl<R: Read> ResponseReader<R> {
             txz: [txz[0], txz[1], txz[2]],
             phi,
             conv,
+            roles,
+            fields: Vec::with_capacity(16),
+            fast: true,
         })
     }
 
@@ -196,11 +218,31 @@ impl<R: Read> ResponseReader<R> {
     }
 
     /// The next validated row, or `None` at the end of the input.
+    ///
+    /// A line without quotes is first parsed in one pass ([`fast_row`]); a line that pass
+    /// does not take (blanks around a field, a bad or non-finite number, a wrong field
+    /// count, ...) is split and checked field by field, which gives the same values and
+    /// names what is wrong.
     pub fn next_row(&mut self) -> Result<Option<ResponseRow>, CsvError> {
-        let f = self.file.as_str();
-        let Some(rec) = next_record(f, &mut self.csv)? else {
-            return Ok(None);
+        let raw = match self.csv.next_raw() {
+            Ok(Some(raw)) => raw,
+            Ok(None) => return Ok(None),
+            Err(e) => return Err(io_error(&self.file, &e.error, e.line)),
         };
+        let rec = match raw {
+            RawRecord::Line { text, line } => {
+                if self.fast {
+                    if let Some(row) =
+                        fast_row(text, line, &self.roles, &self.conv, self.phi.is_some())
+                    {
+                        return Ok(Some(row));
+                    }
+                }
+                split_line(text, line, &mut self.fields)
+            }
+            RawRecord::Quoted(rec) => rec,
+        };
+        let f = self.file.as_str();
         let line = rec.line();
         check_length(f, &rec, line, &self.header)?;
         let conv = &self.conv;
@@ -229,6 +271,60 @@ impl<R: Read> ResponseReader<R> {
             speed,
         }))
     }
+}
+
+/// The row of the plain line `text` parsed in one pass: each used column's number read
+/// where its field starts (`fast_float2::parse_partial`, the parser of the general path,
+/// so the values are the same bit for bit) and followed by `,` or the line's end, unused
+/// columns skipped to the next `,`. `None` when the line needs the general path: anything
+/// but exactly one number in a used field (blanks, empty, text, a number over
+/// [`MAX_FIELD_BYTES`]), a value that is not finite in the file or in SI, or a field count
+/// other than the header's.
+#[inline]
+fn fast_row(
+    text: &[u8],
+    line: u64,
+    roles: &[u8],
+    conv: &[Conversion; 6],
+    has_phi: bool,
+) -> Option<ResponseRow> {
+    let mut v = [0.0_f64; 6];
+    let mut p = 0;
+    let last = roles.len().checked_sub(1)?;
+    for (j, &role) in roles.iter().enumerate() {
+        let rest = text.get(p..)?;
+        if role == UNUSED {
+            p += memchr::memchr(b',', rest).unwrap_or(rest.len());
+        } else {
+            let (raw, n) = fast_float2::parse_partial::<f64, _>(rest).ok()?;
+            let si = conv.get(usize::from(role))?.apply(raw);
+            if n > MAX_FIELD_BYTES || !raw.is_finite() || !si.is_finite() {
+                return None;
+            }
+            v[usize::from(role)] = si;
+            p += n;
+        }
+        if j < last {
+            if text.get(p) != Some(&b',') {
+                return None;
+            }
+            p += 1;
+        }
+    }
+    if p != text.len() {
+        return None;
+    }
+    Some(ResponseRow {
+        line,
+        t: v[0],
+        x: v[1],
+        z: v[2],
+        speed: has_phi.then_some(Speed {
+            phi: v[3],
+            phi_dot: v[4],
+            phi_ddot: v[5],
+        }),
+    })
 }
 
 /// `v` of column `col` in SI by `c`; a finite value that overflows (`1e308 rev`) is an
@@ -274,6 +370,8 @@ pub fn conversion_note(file: &str, name: &str, c: &Conversion) -> String {
 #[cfg(test)]
 mod tests {
     use std::f64::consts::PI;
+
+    use proptest::strategy::Strategy;
 
     use super::*;
 
@@ -458,5 +556,102 @@ mod tests {
             "d.csv line 4: short row: 2 fields where the header (line 1) has 3"
         );
         assert!(err(&format!("{h}0.2,0,0,9\n")).starts_with("d.csv line 4: long row"));
+    }
+
+    /// Every row of `text` with the one-pass parse on or off: the rows' bits, or the error.
+    fn read_both(text: &[u8]) -> [Result<Vec<[u64; 7]>, String>; 2] {
+        [true, false].map(|fast| {
+            let mut r = ResponseReader::new("d.csv", text).map_err(|e| e.to_string())?;
+            r.fast = fast;
+            let mut rows = Vec::new();
+            while let Some(row) = r.next_row().map_err(|e| e.to_string())? {
+                let s = row.speed.map_or([u64::MAX; 3], |s| {
+                    [s.phi.to_bits(), s.phi_dot.to_bits(), s.phi_ddot.to_bits()]
+                });
+                rows.push([
+                    row.line,
+                    row.t.to_bits(),
+                    row.x.to_bits(),
+                    row.z.to_bits(),
+                    s[0],
+                    s[1],
+                    s[2],
+                ]);
+            }
+            Ok(rows)
+        })
+    }
+
+    #[test]
+    fn the_one_pass_parse_takes_plain_rows_and_leaves_the_rest() {
+        let roles = [0, 1, 2];
+        let conv = RESPONSE_QUANTITIES.map(Conversion::si);
+        let row = |t: &str| fast_row(t.as_bytes(), 7, &roles, &conv, false);
+        let r = row("0.5,-1.25e-7,3").unwrap();
+        assert_eq!(
+            (r.line, r.t, r.x, r.z, r.speed),
+            (7, 0.5, -1.25e-7, 3.0, None)
+        );
+        for general in [
+            " 0.5,1,2",
+            "0.5,1,2 ",
+            "0.5,,2",
+            "0.5,1",
+            "0.5,1,2,",
+            "0.5,1,2,3",
+            "nan,1,2",
+            "0.5,inf,2",
+            "0.5,1e400,2",
+            "0.5,1x,2",
+            "0.5,1e,2",
+            "",
+            "0.5;1;2",
+        ] {
+            assert!(row(general).is_none(), "{general:?}");
+        }
+        let long = format!("0.{},1,2", "0".repeat(MAX_FIELD_BYTES));
+        assert!(row(&long).is_none(), "a number over MAX_FIELD_BYTES");
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(3000))]
+
+        /// Rows read with and without the one-pass parse are the same bit for bit, and a
+        /// refused file gives the same message, whatever the header's order, units and
+        /// extra columns and whatever the fields hold.
+        #[test]
+        fn the_one_pass_parse_changes_no_value_and_no_message(
+            header in proptest::sample::select(vec![
+                "t,x,z", "x,t,z,note", "t (ms),x [um],z,phi,phi_dot,phi_ddot",
+                "note,phi_ddot,phi,z,x,phi_dot [rpm],t",
+                "t,x [mm],z,phi [deg],phi_dot,phi_ddot [rpm/s]",
+            ]),
+            rows in proptest::collection::vec(
+                proptest::collection::vec(
+                    proptest::prop_oneof![
+                        4 => (-1e6f64..1e6).prop_map(|v| v.to_string()),
+                        4 => proptest::num::f64::NORMAL.prop_map(|v| format!("{v:e}")),
+                        1 => proptest::sample::select(vec![
+                            "", " 1", "1 ", "nan", "-inf", "inf", "1e400", "-1e-400", "+2.5",
+                            ".5", "5.", "1e", "0x10", "abc", "1_0", "\"3\"", "1e308",
+                            "-0", "00012", "1.7976931348623157e308", "4.9e-324",
+                        ]).prop_map(str::to_owned),
+                    ],
+                    5..9,
+                ),
+                0..6,
+            ),
+        ) {
+            let cols = header.split(',').count();
+            let mut text = format!("{header}\n");
+            for (i, row) in rows.iter().enumerate() {
+                // mostly the header's count of fields, sometimes one more or fewer
+                let n = match i % 4 { 1 => cols + 1, 3 => cols - 1, _ => cols }.min(row.len());
+                text.push_str(&row[..n].join(","));
+                text.push_str(if i % 2 == 0 { "\n" } else { "\r\n" });
+            }
+            let [fast, general] = read_both(text.as_bytes());
+            proptest::prop_assert_eq!(fast, general, "{}", text);
+        }
     }
 }
