@@ -21,18 +21,25 @@ use crate::table::Table;
 
 /// Reads a `.mat` file's bytes, level 5 or v7.3 as its header says.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
-    if bytes.len() >= 128 && bytes.starts_with(b"MATLAB") {
-        let v = [bytes[124], bytes[125]];
-        let hdf5 = bytes.get(512..520) == Some(b"\x89HDF\r\n\x1a\n".as_slice());
-        if v == [0x00, 0x02] || v == [0x02, 0x00] || hdf5 {
-            return v73::read(file, bytes);
-        }
+    if is_v73(bytes) {
+        return v73::read(file, bytes);
     }
     v5::read(file, bytes)
 }
 
-/// Reads the `.mat` file at `path`: level 5 element by element ([`v5::read_file`]: memory
-/// holds the channels and one variable), v7.3 whole.
+/// True when the file starting with `head` (its first 520 bytes or more) is v7.3: the
+/// header's version, or the HDF5 signature after the 512-byte user block.
+fn is_v73(head: &[u8]) -> bool {
+    head.len() >= 128
+        && head.starts_with(b"MATLAB")
+        && ([head[124], head[125]] == [0x00, 0x02]
+            || [head[124], head[125]] == [0x02, 0x00]
+            || head.get(512..520) == Some(b"\x89HDF\r\n\x1a\n".as_slice()))
+}
+
+/// Reads the `.mat` file at `path` from disk: level 5 element by element
+/// ([`v5::read_file`]: memory holds the channels and one variable), v7.3 through the HDF5
+/// layer's streaming mode ([`v73::read_file`]).
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
     use std::io::Read as _;
     let io = |source| ReadError::Io {
@@ -45,14 +52,8 @@ pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError>
         .take(520)
         .read_to_end(&mut head)
         .map_err(io)?;
-    let v73 = head.len() >= 128
-        && head.starts_with(b"MATLAB")
-        && ([head[124], head[125]] == [0x00, 0x02]
-            || [head[124], head[125]] == [0x02, 0x00]
-            || head.get(512..520) == Some(b"\x89HDF\r\n\x1a\n".as_slice()));
-    if v73 {
-        let bytes = std::fs::read(path).map_err(io)?;
-        return v73::read(file, &bytes);
+    if is_v73(&head) {
+        return v73::read_file(file, path);
     }
     v5::read_file(file, path)
 }

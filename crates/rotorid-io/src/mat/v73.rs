@@ -30,9 +30,31 @@ const NUMERIC: &[&str] = &[
 
 /// Reads a v7.3 MAT-file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
-    let limit = (bytes.len() as u64).saturating_mul(1032);
+    read_hdf5(file, bytes.len() as u64, || File::from_bytes(bytes.to_vec()))
+}
+
+/// Reads the v7.3 MAT-file at `path` from disk as the HDF5 layer needs it (its streaming
+/// mode: metadata and chunks read on demand), so memory holds the channels and one chunk
+/// rather than the whole file as well. Accepts and refuses what [`read`] does.
+pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
+    let len = std::fs::metadata(path)
+        .map_err(|source| ReadError::Io {
+            file: file.to_string(),
+            source,
+        })?
+        .len();
+    read_hdf5(file, len, || File::open_streaming(path))
+}
+
+/// The channels of the HDF5 file `open` gives, `len` bytes long.
+fn read_hdf5(
+    file: &str,
+    len: u64,
+    open: impl FnOnce() -> Result<File, hdf5_pure::Error>,
+) -> Result<Table, ReadError> {
+    let limit = len.saturating_mul(1032);
     let run = || -> Result<Table, ReadError> {
-        let h5 = File::from_bytes(bytes.to_vec()).map_err(|e| err(file, None, e))?;
+        let h5 = open().map_err(|e| err(file, None, e))?;
         let root = h5.root();
         let mut channels = Vec::new();
         let mut skipped = Vec::new();
