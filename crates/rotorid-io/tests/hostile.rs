@@ -188,7 +188,10 @@ fn reading_from_disk_refuses_what_the_bytes_reader_refuses() {
                 (Err(a), Err(b)) if name.contains("v73") => {
                     let head = |e: &rotorid_io::ReadError| {
                         let s = e.to_string();
-                        s.split(": HDF5 format error").next().unwrap_or(&s).to_owned()
+                        s.split(": HDF5 format error")
+                            .next()
+                            .unwrap_or(&s)
+                            .to_owned()
                     };
                     assert_eq!(head(&a), head(&b), "{name} ({len} bytes)");
                     assert_eq!(

@@ -130,6 +130,45 @@ impl Header {
     }
 }
 
+/// The numbers of the plain line `text` (no quote, line end excluded) in one pass, for the
+/// readers' fast path: `cols` fields separated by `,`; field `j` is parsed where it starts by
+/// fast-float2's `parse_partial` (the parser [`number_field`] uses, so a value is the same bit
+/// for bit) when `used(j)` and must be exactly one number of at most [`MAX_FIELD_BYTES`]
+/// bytes, then `take(j, value)` decides (`None`: the line needs the general path); an unused
+/// field is skipped to the next `,`. `None` for anything else (blanks, an empty or
+/// non-number field, another field count): the caller then splits and checks the line
+/// field by field, which names what is wrong.
+#[inline]
+pub fn one_pass(
+    text: &[u8],
+    cols: usize,
+    used: impl Fn(usize) -> bool,
+    mut take: impl FnMut(usize, f64) -> Option<()>,
+) -> Option<()> {
+    let last = cols.checked_sub(1)?;
+    let mut p = 0;
+    for j in 0..cols {
+        let rest = text.get(p..)?;
+        if used(j) {
+            let (v, n) = fast_float2::parse_partial::<f64, _>(rest).ok()?;
+            if n > MAX_FIELD_BYTES {
+                return None;
+            }
+            take(j, v)?;
+            p += n;
+        } else {
+            p += memchr::memchr(b',', rest).unwrap_or(rest.len());
+        }
+        if j < last {
+            if text.get(p) != Some(&b',') {
+                return None;
+            }
+            p += 1;
+        }
+    }
+    (p == text.len()).then_some(())
+}
+
 /// Parse field `col` of `rec` as an `f64` that must be finite. `name` is the column's
 /// name for the message, `line` the record's line.
 pub fn finite_field(

@@ -35,8 +35,7 @@ use std::io::Read;
 use std::ops::Range;
 
 use super::columns::{
-    check_length, csv_reader, finite_field, io_error, next_record, CsvReader, Header,
-    MAX_FIELD_BYTES,
+    check_length, csv_reader, finite_field, io_error, next_record, one_pass, CsvReader, Header,
 };
 use super::error::CsvError;
 use super::number::{format_f64, readable};
@@ -273,13 +272,9 @@ impl<R: Read> ResponseReader<R> {
     }
 }
 
-/// The row of the plain line `text` parsed in one pass: each used column's number read
-/// where its field starts (`fast_float2::parse_partial`, the parser of the general path,
-/// so the values are the same bit for bit) and followed by `,` or the line's end, unused
-/// columns skipped to the next `,`. `None` when the line needs the general path: anything
-/// but exactly one number in a used field (blanks, empty, text, a number over
-/// [`MAX_FIELD_BYTES`]), a value that is not finite in the file or in SI, or a field count
-/// other than the header's.
+/// The row of the plain line `text` parsed in one pass ([`one_pass`]: the same values bit
+/// for bit as the general path); `None` when the line needs the general path, which also
+/// refuses a value that is not finite in the file or in SI.
 #[inline]
 fn fast_row(
     text: &[u8],
@@ -289,31 +284,20 @@ fn fast_row(
     has_phi: bool,
 ) -> Option<ResponseRow> {
     let mut v = [0.0_f64; 6];
-    let mut p = 0;
-    let last = roles.len().checked_sub(1)?;
-    for (j, &role) in roles.iter().enumerate() {
-        let rest = text.get(p..)?;
-        if role == UNUSED {
-            p += memchr::memchr(b',', rest).unwrap_or(rest.len());
-        } else {
-            let (raw, n) = fast_float2::parse_partial::<f64, _>(rest).ok()?;
-            let si = conv.get(usize::from(role))?.apply(raw);
-            if n > MAX_FIELD_BYTES || !raw.is_finite() || !si.is_finite() {
+    one_pass(
+        text,
+        roles.len(),
+        |j| roles[j] != UNUSED,
+        |j, raw| {
+            let role = usize::from(roles[j]);
+            let si = conv.get(role)?.apply(raw);
+            if !(raw.is_finite() && si.is_finite()) {
                 return None;
             }
-            v[usize::from(role)] = si;
-            p += n;
-        }
-        if j < last {
-            if text.get(p) != Some(&b',') {
-                return None;
-            }
-            p += 1;
-        }
-    }
-    if p != text.len() {
-        return None;
-    }
+            v[role] = si;
+            Some(())
+        },
+    )?;
     Some(ResponseRow {
         line,
         t: v[0],
@@ -609,7 +593,10 @@ mod tests {
         ] {
             assert!(row(general).is_none(), "{general:?}");
         }
-        let long = format!("0.{},1,2", "0".repeat(MAX_FIELD_BYTES));
+        let long = format!(
+            "0.{},1,2",
+            "0".repeat(super::super::columns::MAX_FIELD_BYTES)
+        );
         assert!(row(&long).is_none(), "a number over MAX_FIELD_BYTES");
     }
 

@@ -6,13 +6,21 @@
 
 use std::io::Read;
 
-use super::columns::{check_length, csv_reader, next_record, number_field, Header};
+use super::columns::{
+    check_length, csv_reader, io_error, next_record, number_field, one_pass, Header,
+};
 use super::error::CsvError;
+use super::records::{split_line, RawRecord};
 use crate::table::{Channel, Table};
 use crate::units::split_unit;
 
 /// Read the CSV `input` whole; `file` names it in messages and in the table.
 pub fn read_csv_table<R: Read>(file: &str, input: R) -> Result<Table, CsvError> {
+    read(file, input, true)
+}
+
+/// [`read_csv_table`], its one-pass parse of plain lines on or off (off only in tests).
+fn read<R: Read>(file: &str, input: R, fast: bool) -> Result<Table, CsvError> {
     let mut csv = csv_reader(input);
     let Some(rec) = next_record(file, &mut csv)? else {
         return Err(CsvError::file(
@@ -36,7 +44,39 @@ pub fn read_csv_table<R: Read>(file: &str, input: R) -> Result<Table, CsvError> 
             }
         })
         .collect();
-    while let Some(rec) = next_record(file, &mut csv)? {
+    // A plain line is parsed in one pass into `row` (columns::one_pass: the same values as
+    // the general path); any other goes field by field, which names what is wrong.
+    let mut row = vec![0.0; channels.len()];
+    let mut fields = Vec::with_capacity(channels.len());
+    loop {
+        let raw = match csv.next_raw() {
+            Ok(Some(raw)) => raw,
+            Ok(None) => break,
+            Err(e) => return Err(io_error(file, &e.error, e.line)),
+        };
+        let rec = match raw {
+            RawRecord::Line { text, line } => {
+                let parsed = fast
+                    && one_pass(
+                        text,
+                        row.len(),
+                        |_| true,
+                        |j, v| {
+                            row[j] = v;
+                            Some(())
+                        },
+                    )
+                    .is_some();
+                if parsed {
+                    for (ch, &v) in channels.iter_mut().zip(&row) {
+                        ch.data.push(v);
+                    }
+                    continue;
+                }
+                split_line(text, line, &mut fields)
+            }
+            RawRecord::Quoted(rec) => rec,
+        };
         let line = rec.line();
         check_length(file, &rec, line, &header)?;
         for (col, ch) in channels.iter_mut().enumerate() {
@@ -51,6 +91,8 @@ pub fn read_csv_table<R: Read>(file: &str, input: R) -> Result<Table, CsvError> 
 
 #[cfg(test)]
 mod tests {
+    use proptest::strategy::Strategy;
+
     use super::*;
 
     #[test]
@@ -78,5 +120,49 @@ mod tests {
         let e = read_csv_table("raw.csv", "t,v\n0\n".as_bytes()).unwrap_err();
         assert!(e.to_string().starts_with("raw.csv line 2"), "{e}");
         assert!(read_csv_table("raw.csv", "".as_bytes()).is_err());
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+
+        /// With and without the one-pass parse, the same channels bit for bit (NaN and
+        /// infinities included) or the same message.
+        #[test]
+        fn the_one_pass_parse_changes_no_value_and_no_message(
+            cols in 1usize..5,
+            rows in proptest::collection::vec(
+                proptest::collection::vec(
+                    proptest::prop_oneof![
+                        4 => proptest::num::f64::ANY.prop_map(|v| format!("{v:e}")),
+                        2 => (-1e3f64..1e3).prop_map(|v| v.to_string()),
+                        1 => proptest::sample::select(vec![
+                            "", " 1", "1 ", "nan", "NaN", "-inf", "inf", "Infinity", "1e400",
+                            "+2.5", ".5", "5.", "1e", "0x10", "abc", "\"3\"", "-0", "nan(1)",
+                        ]).prop_map(str::to_owned),
+                    ],
+                    6,
+                ),
+                0..6,
+            ),
+        ) {
+            let mut text = (0..cols).map(|c| format!("c{c}")).collect::<Vec<_>>().join(",");
+            text.push('\n');
+            for (i, row) in rows.iter().enumerate() {
+                let n = match i % 4 { 1 => cols + 1, 3 => cols - 1, _ => cols };
+                text.push_str(&row[..n].join(","));
+                text.push('\n');
+            }
+            let bits = |fast| {
+                read("t.csv", text.as_bytes(), fast)
+                    .map(|t| {
+                        t.channels
+                            .iter()
+                            .map(|c| c.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+                            .collect::<Vec<_>>()
+                    })
+                    .map_err(|e| e.to_string())
+            };
+            proptest::prop_assert_eq!(bits(true), bits(false), "{}", text);
+        }
     }
 }

@@ -30,7 +30,9 @@ const NUMERIC: &[&str] = &[
 
 /// Reads a v7.3 MAT-file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
-    read_hdf5(file, bytes.len() as u64, || File::from_bytes(bytes.to_vec()))
+    read_hdf5(file, bytes.len() as u64, || {
+        File::from_bytes(bytes.to_vec())
+    })
 }
 
 /// Reads the v7.3 MAT-file at `path` from disk as the HDF5 layer needs it (its streaming
