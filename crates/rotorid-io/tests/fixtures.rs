@@ -1,5 +1,8 @@
 //! Each reader against the values the reference tools wrote (fixtures/make.py: numpy,
 //! scipy.io.savemat, h5py, npTDMS, pyuff, pyarrow), recorded in fixtures/expected.json.
+//! The identifiable record ident.csv, written by every tool as ident.*, is checked here
+//! channel by channel against the CSV's decimals; rotorid-cli's tests/it/formats.rs
+//! identifies each of those files.
 
 use std::path::{Path, PathBuf};
 
@@ -30,6 +33,23 @@ fn variant(e: &ReadError) -> &'static str {
         ReadError::Container { .. } => "Container",
         _ => "other",
     }
+}
+
+/// The column a reference `"ident.csv:x"` names, parsed here with `str::parse` (correctly
+/// rounded, as numpy's loadtxt that make.py checked it with), not by the CSV reader.
+fn column(reference: &str) -> Vec<f64> {
+    let (file, name) = reference.split_once(':').expect("FILE:COLUMN");
+    let text = std::fs::read_to_string(dir().join(file)).unwrap();
+    let mut lines = text.lines();
+    let k = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("{reference}: no such column"));
+    lines
+        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
+        .collect()
 }
 
 /// Checks every fixture whose name ends with one of `exts`; returns how many.
@@ -82,7 +102,10 @@ fn check(exts: &[&str]) -> usize {
                     );
                 }
             }
-            let data: Vec<f64> = w["data"].as_array().unwrap().iter().map(num).collect();
+            let data: Vec<f64> = match &w["data"] {
+                Value::String(r) => column(r),
+                d => d.as_array().unwrap().iter().map(num).collect(),
+            };
             assert_eq!(c.data.len(), data.len(), "{file}/{name}: length");
             for (i, (a, b)) in c.data.iter().zip(&data).enumerate() {
                 assert!(
@@ -102,32 +125,37 @@ fn npy_matches_numpy() {
 
 #[test]
 fn npz_matches_numpy() {
-    assert_eq!(check(&[".npz"]), 2);
+    assert_eq!(check(&[".npz"]), 3);
 }
 
 #[test]
 fn mat_v5_matches_scipy() {
-    assert_eq!(check(&["_v5.mat", "_v5_compressed.mat"]), 4);
+    assert_eq!(check(&["_v5.mat", "_v5_compressed.mat"]), 6);
 }
 
 #[test]
 fn mat_v73_matches_h5py() {
-    assert_eq!(check(&["_v73.mat"]), 1);
+    assert_eq!(check(&["_v73.mat"]), 2);
 }
 
 #[test]
 fn tdms_matches_nptdms() {
-    assert_eq!(check(&[".tdms"]), 3);
+    assert_eq!(check(&[".tdms"]), 4);
 }
 
 #[test]
 fn uff58_matches_pyuff() {
-    assert_eq!(check(&[".uff"]), 3);
+    assert_eq!(check(&[".uff"]), 4);
 }
 
 #[test]
 fn parquet_matches_pyarrow() {
-    assert_eq!(check(&[".parquet"]), 2);
+    assert_eq!(check(&[".parquet"]), 3);
+}
+
+#[test]
+fn csv_matches_the_decimals() {
+    assert_eq!(check(&[".csv"]), 1);
 }
 
 #[test]
