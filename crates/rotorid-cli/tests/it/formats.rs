@@ -1,8 +1,9 @@
-//! Records in every format rotorid reads: the same record written as CSV, Parquet, MAT and
-//! NPZ (by `rotorid simulate --out`, whose writers are checked against numpy, scipy and
-//! pyarrow in crates/rotorid-io/tests) identifies bit for bit alike; `--columns` picks
-//! channels by other names; `inspect` lists a file's channels; a raw acquisition (probe
-//! volts, keyphasor, slow roll) is conditioned and identified within its standard errors.
+//! Records in every format rotorid reads: the same record written by each format's
+//! reference tool (NPZ, Parquet, MAT level 5 and v7.3, TDMS, UFF 58b: the fixtures of
+//! crates/rotorid-io) and by `rotorid simulate --out` (Parquet, MAT, NPZ) identifies bit
+//! for bit like its CSV; `--columns` picks channels by other names; `inspect` lists a
+//! file's channels; a raw acquisition (probe volts, keyphasor, slow roll) is conditioned
+//! and identified within its standard errors.
 
 use std::path::Path;
 
@@ -21,13 +22,88 @@ fn summary(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
+const METHODS: [&str; 3] = ["algebraic", "modulating", "refine"];
+
+/// `identify REC --scenario table1 --method METHOD [--columns COLUMNS]` into `dir`: the
+/// estimates CSV's bytes and the summary with its "input" (the file's name) nulled.
+fn identify(dir: &Path, rec: &str, method: &str, columns: Option<&str>) -> (Vec<u8>, Value) {
+    let (est, sum) = (dir.join("est.csv"), dir.join("s.json"));
+    let mut args = vec![
+        "identify",
+        rec,
+        "--scenario",
+        "table1",
+        "--method",
+        method,
+        "--out",
+        est.to_str().unwrap(),
+        "--summary",
+        sum.to_str().unwrap(),
+        "-q",
+    ];
+    if let Some(c) = columns {
+        args.extend(["--columns", c]);
+    }
+    run(&args);
+    let mut s = summary(&sum);
+    s["input"] = Value::Null;
+    (std::fs::read(&est).unwrap(), s)
+}
+
+/// Asserts that `rec` identifies with every method exactly as `reference` did.
+fn identifies_like(dir: &Path, rec: &str, columns: Option<&str>, reference: &[(Vec<u8>, Value)]) {
+    for (method, (e0, s0)) in METHODS.iter().zip(reference) {
+        let (est, s) = identify(dir, rec, method, columns);
+        assert!(
+            &est == e0,
+            "{rec} {method}: the estimates differ from the CSV's"
+        );
+        assert_eq!(&s, s0, "{rec} {method}: the summary differs from the CSV's");
+    }
+}
+
+/// The acceptance test: one record (crates/rotorid-io/fixtures/ident.csv, made by
+/// `rotorid simulate`) written by each ecosystem's reference tool (fixtures/make.py:
+/// numpy, pyarrow, scipy.io.savemat, h5py as MATLAB -v7.3, npTDMS, pyuff 58b) identifies
+/// bit for bit like the CSV with every method.
 #[test]
-fn every_format_identifies_bit_for_bit_like_the_csv() {
+fn every_reference_tools_file_identifies_bit_for_bit_like_the_csv() {
     let dir = tempfile::tempdir().unwrap();
-    let p = |n: &str| dir.path().join(n).to_string_lossy().into_owned();
-    let mut results = Vec::new();
+    let fixture = |n: &str| format!("{}/../rotorid-io/fixtures/{n}", env!("CARGO_MANIFEST_DIR"));
+    let reference: Vec<_> = METHODS
+        .iter()
+        .map(|m| identify(dir.path(), &fixture("ident.csv"), m, None))
+        .collect();
+    for (file, columns) in [
+        ("ident.npz", None),
+        ("ident.parquet", None),
+        ("ident_v5.mat", None),
+        // rec.t, rec.x, ... found by their short names
+        ("ident_struct_v5_compressed.mat", None),
+        ("ident_v73.mat", None),
+        // rotor/t, rotor/x, ...: time from the t channel, not from the waveform axis
+        // (wf_start_offset 0.25 s) that x, z, phi, ... carry
+        ("ident.tdms", None),
+        (
+            "ident.tdms",
+            Some("rotor/t,rotor/x,rotor/z,rotor/phi,rotor/phi_dot,rotor/phi_ddot"),
+        ),
+        // a dataset per channel, t among them (record 7's abscissa, E13.5 text, starts at
+        // 0.25 s)
+        ("ident_58b.uff", None),
+    ] {
+        identifies_like(dir.path(), &fixture(file), columns, &reference);
+    }
+}
+
+/// Our own writers (`simulate --out` Parquet, MAT, NPZ) keep a record bit for bit too.
+#[test]
+fn every_format_rotorid_writes_identifies_bit_for_bit_like_the_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut reference = Vec::new();
     for ext in ["csv", "parquet", "mat", "npz"] {
-        let rec = p(&format!("r.{ext}"));
+        let rec = dir.path().join(format!("r.{ext}"));
+        let rec = rec.to_str().unwrap();
         run(&[
             "simulate",
             "--scenario",
@@ -39,40 +115,17 @@ fn every_format_identifies_bit_for_bit_like_the_csv() {
             "--seed",
             "5",
             "--out",
-            &rec,
+            rec,
             "-q",
         ]);
-        for method in ["algebraic", "modulating", "refine"] {
-            let est = p(&format!("e_{ext}_{method}.csv"));
-            let sum = p(&format!("s_{ext}_{method}.json"));
-            run(&[
-                "identify",
-                &rec,
-                "--scenario",
-                "table1",
-                "--method",
-                method,
-                "--out",
-                &est,
-                "--summary",
-                &sum,
-                "-q",
-            ]);
-            let mut s = summary(Path::new(&sum));
-            s["input"] = Value::Null;
-            results.push((ext, method, std::fs::read(&est).unwrap(), s));
+        if ext == "csv" {
+            reference = METHODS
+                .iter()
+                .map(|m| identify(dir.path(), rec, m, None))
+                .collect();
+        } else {
+            identifies_like(dir.path(), rec, None, &reference);
         }
-    }
-    for (ext, method, est, s) in &results[3..] {
-        let (_, _, e0, s0) = results
-            .iter()
-            .find(|r| r.0 == "csv" && r.1 == *method)
-            .unwrap();
-        assert!(
-            est == e0,
-            "{ext} {method}: the estimates differ from the CSV's"
-        );
-        assert_eq!(s, s0, "{ext} {method}: the summary differs from the CSV's");
     }
 }
 
