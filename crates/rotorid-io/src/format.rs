@@ -1,6 +1,7 @@
 //! Which reader a file goes to: by its extension ([`Format::from_path`]), then for `.mat`
 //! by its header (v5, or v7.3 which is HDF5).
 
+use std::borrow::Cow;
 use std::path::Path;
 
 use crate::error::ReadError;
@@ -72,6 +73,7 @@ pub fn read_table(path: impl AsRef<Path>) -> Result<Table, ReadError> {
         Format::Parquet => return crate::parquet::read_file(&file, path),
         Format::Npz => return crate::npz::read_file(&file, path),
         Format::Mat => return crate::mat::read_file(&file, path),
+        Format::Tdms => return crate::tdms::read_file(&file, path),
         _ => {}
     }
     let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
@@ -133,5 +135,35 @@ impl<'a> DiskFile<'a> {
     /// A second handle on the file (for readers that take ownership).
     pub fn handle(&self) -> Result<std::fs::File, ReadError> {
         self.f.try_clone().map_err(|e| Self::io(self.file, e))
+    }
+}
+
+/// A file's bytes at offsets: all of them in memory (`[u8]`, read as they lie) or a
+/// [`DiskFile`] (read piece by piece), so that a reader written once over it reads both
+/// ways with the same checks and messages.
+pub(crate) trait Source {
+    /// Size \[bytes\].
+    fn size(&self) -> u64;
+    /// The bytes `[at, at + len)` (the caller keeps them within the size).
+    fn read_at(&self, at: u64, len: u64) -> Result<Cow<'_, [u8]>, ReadError>;
+}
+
+impl Source for [u8] {
+    fn size(&self) -> u64 {
+        self.len() as u64
+    }
+
+    fn read_at(&self, at: u64, len: u64) -> Result<Cow<'_, [u8]>, ReadError> {
+        Ok(Cow::Borrowed(&self[at as usize..(at + len) as usize]))
+    }
+}
+
+impl Source for DiskFile<'_> {
+    fn size(&self) -> u64 {
+        self.size
+    }
+
+    fn read_at(&self, at: u64, len: u64) -> Result<Cow<'_, [u8]>, ReadError> {
+        DiskFile::read_at(self, at, len).map(Cow::Owned)
     }
 }

@@ -29,6 +29,7 @@ use std::collections::HashMap;
 
 use crate::cursor::Cursor;
 use crate::error::ReadError;
+use crate::format::Source;
 use crate::num::{Dtype, Endian};
 use crate::table::{Channel, Table, TimeAxis};
 
@@ -65,17 +66,41 @@ struct Object {
 
 /// Reads a TDMS file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
-    let mut c = Cursor::new(file, bytes);
+    read_from(file, bytes)
+}
+
+/// Reads the TDMS file at `path` segment by segment: its lead-in, its metadata, then its
+/// raw data a block of at most [`BLOCK`] bytes at a time, each channel's samples appended
+/// as they are read; memory holds the channels, one segment's metadata and one block,
+/// never the whole file. Accepts and refuses what [`read`] does, with the same messages.
+pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
+    let disk = crate::format::DiskFile::open(file, path)?;
+    read_from(file, &disk)
+}
+
+/// Bytes of raw data decoded at a time (one block of one channel, or of interleaved rows).
+const BLOCK: u64 = 1 << 18;
+
+/// Reads the segments of `src`, in memory or on disk; every length is checked against
+/// the bytes the file has left before anything of that length is read.
+fn read_from<S: Source + ?Sized>(file: &str, src: &S) -> Result<Table, ReadError> {
+    let size = src.size();
     let mut objects: Vec<Object> = Vec::new();
     let mut by_path: HashMap<String, usize> = HashMap::new();
     // The object list of the current segment: object, and its raw index there.
     let mut list: Vec<(usize, Option<RawIndex>)> = Vec::new();
-    while !c.at_end() {
-        let seg = c.pos;
+    let mut seg = 0u64;
+    while seg < size {
+        // The lead-in, or what the file has of it (the cursor refuses a short one).
+        let head = src.read_at(seg, LEAD_IN.min(size - seg))?;
+        let mut c = Cursor {
+            base: seg,
+            ..Cursor::new(file, &head)
+        };
         let tag = c.take(4, "TDMS segment tag")?;
         if tag != b"TDSm" {
             return Err(c.invalid_at(
-                seg,
+                0,
                 "TDMS segment tag",
                 format!("{tag:?}"),
                 "\"TDSm\" (a .tdms_index file is not read)",
@@ -89,18 +114,18 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
         };
         let version = c.u32(e, "TDMS version")?;
         if version != 4712 && version != 4713 {
-            return Err(c.invalid_at(seg + 8, "TDMS version", version, "4712 or 4713"));
+            return Err(c.invalid_at(8, "TDMS version", version, "4712 or 4713"));
         }
         let next = c.u64(e, "TDMS next segment offset")?;
         let raw = c.u64(e, "TDMS raw data offset")?;
-        let lead_end = c.pos;
-        let left = c.remaining() as u64;
+        let lead_end = seg + LEAD_IN;
+        let left = size - lead_end;
         let seg_len = if next == u64::MAX { left } else { next };
         if seg_len > left {
             return Err(ReadError::Truncated {
                 file: file.to_string(),
                 channel: None,
-                offset: seg as u64,
+                offset: seg,
                 what: "TDMS segment".into(),
                 need: seg_len.saturating_add(LEAD_IN),
                 available: left + LEAD_IN,
@@ -108,7 +133,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
         }
         if raw > seg_len {
             return Err(c.invalid_at(
-                seg + 20,
+                20,
                 "TDMS raw data offset",
                 raw,
                 format!("at most the segment's {seg_len} bytes"),
@@ -116,34 +141,35 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
         }
         if toc & TOC_DAQMX != 0 {
             return Err(c.invalid_at(
-                seg + 4,
+                4,
                 "TDMS table of contents",
                 format!("{toc:#x} (DAQmx raw data)"),
                 "segments without kTocDAQmxRawData: DAQmx raw data is not read",
             ));
         }
-        let seg_end = lead_end + seg_len as usize;
-        let raw_start = lead_end + raw as usize;
+        let seg_end = lead_end + seg_len;
+        let raw_start = lead_end + raw;
         if toc & TOC_META != 0 {
             if toc & TOC_NEW_LIST != 0 {
                 list.clear();
             }
+            let meta = src.read_at(lead_end, raw)?;
             let mut m = Cursor {
-                data: &bytes[..raw_start],
-                pos: lead_end,
-                ..c.clone()
+                base: lead_end,
+                ..Cursor::new(file, &meta)
             };
             metadata(&mut m, e, &mut objects, &mut by_path, &mut list)?;
         }
         if toc & TOC_RAW != 0 {
-            let r = Cursor {
-                data: &bytes[..seg_end],
-                pos: raw_start,
-                ..c.clone()
+            let raw = Raw {
+                file,
+                start: raw_start,
+                end: seg_end,
+                e,
             };
-            raw_data(&r, e, toc & TOC_INTERLEAVED != 0, &mut objects, &list)?;
+            raw_data(src, &raw, toc & TOC_INTERLEAVED != 0, &mut objects, &list)?;
         }
-        c.pos = seg_end;
+        seg = seg_end;
     }
     let mut channels = Vec::new();
     for o in objects {
@@ -386,19 +412,76 @@ fn metadata(
     Ok(())
 }
 
-fn raw_data(
-    c: &Cursor,
+/// Where a segment's raw data lies: file offsets `[start, end)`, byte order `e`.
+struct Raw<'a> {
+    file: &'a str,
+    start: u64,
+    end: u64,
     e: Endian,
+}
+
+impl Raw<'_> {
+    /// `n` values of `t` of `channel` at file offset `at`, one every `stride` bytes, read
+    /// from `src`; the values are numbers `first..first + n` of the chunk's channel (as an
+    /// [`ReadError::InexactInteger`] counts them). The caller keeps them within the raw data.
+    #[allow(clippy::too_many_arguments)]
+    fn samples<S: Source + ?Sized>(
+        &self,
+        src: &S,
+        at: u64,
+        first: u64,
+        n: u64,
+        stride: u64,
+        t: Dtype,
+        channel: &str,
+    ) -> Result<Vec<f64>, ReadError> {
+        let len = n.saturating_sub(1) * stride + t.size() as u64;
+        let buf = src.read_at(at, len)?;
+        let c = Cursor {
+            base: at,
+            ..Cursor::new(self.file, &buf)
+        };
+        c.samples(0, n, stride, t, self.e, channel)
+            .map_err(|err| match err {
+                ReadError::InexactInteger {
+                    file,
+                    channel,
+                    index,
+                    offset,
+                    value,
+                } => ReadError::InexactInteger {
+                    file,
+                    channel,
+                    index: index + first as usize,
+                    offset,
+                    value,
+                },
+                other => other,
+            })
+    }
+}
+
+/// Reads the raw data `r` of a segment with object list `list` into the objects' data, a
+/// block of at most [`BLOCK`] bytes at a time, in the order (and so with the first error)
+/// of reading each chunk channel after channel.
+fn raw_data<S: Source + ?Sized>(
+    src: &S,
+    r: &Raw,
     interleaved: bool,
     objects: &mut [Object],
     list: &[(usize, Option<RawIndex>)],
 ) -> Result<(), ReadError> {
+    // errors about the whole raw data name its first byte
+    let c = Cursor {
+        base: r.start,
+        ..Cursor::new(r.file, &[])
+    };
     let present: Vec<(usize, RawIndex)> = list
         .iter()
         .filter_map(|&(k, i)| i.map(|i| (k, i)))
         .filter(|(_, i)| i.bytes > 0)
         .collect();
-    let region = c.remaining() as u64;
+    let region = r.end - r.start;
     let Some(chunk) = present
         .iter()
         .try_fold(0u64, |a, (_, i)| a.checked_add(i.bytes))
@@ -421,42 +504,111 @@ fn raw_data(
     }
     let chunks = region / chunk;
     let name = |objects: &[Object], k: usize| objects[k].path.join("/");
-    let mut pos = c.pos;
-    for _ in 0..chunks {
-        if interleaved {
-            let count = present[0].1.count;
-            let row: u64 = present.iter().map(|(_, i)| i.size).sum();
-            let mut col = 0;
-            for &(k, i) in &present {
-                if i.count != count || i.size == 0 {
-                    return Err(c.invalid(
-                        "TDMS interleaved raw data",
-                        format!(
-                            "{} with {} values of {} bytes",
-                            name(objects, k),
-                            i.count,
-                            i.size
-                        ),
-                        format!("every channel with {count} fixed-size values"),
-                    ));
-                }
-                if let Some(d) = i.dtype {
-                    let v = c.samples(pos + col as usize, count, row, d, e, &name(objects, k))?;
-                    objects[k].data.extend(v);
-                }
-                col += i.size;
-            }
-        } else {
-            let mut p = pos;
-            for &(k, i) in &present {
-                if let Some(d) = i.dtype {
-                    let v = c.samples(p, i.count, i.size, d, e, &name(objects, k))?;
-                    objects[k].data.extend(v);
-                }
-                p += i.bytes as usize;
-            }
+    if interleaved {
+        return interleaved_data(src, r, &c, &present, chunk, chunks, objects);
+    }
+    // Every value of a numeric channel lies in the raw data, so this is at most a value
+    // per raw byte.
+    for &(k, i) in &present {
+        if i.dtype.is_some() {
+            objects[k]
+                .data
+                .reserve(i.count.saturating_mul(chunks) as usize);
         }
-        pos += chunk as usize;
+    }
+    for n in 0..chunks {
+        let mut p = r.start + n * chunk;
+        for &(k, i) in &present {
+            if let Some(d) = i.dtype {
+                let ch = name(objects, k);
+                let per = (BLOCK / i.size).max(1);
+                let mut first = 0;
+                while first < i.count {
+                    let m = per.min(i.count - first);
+                    let at = p + first * i.size;
+                    let v = r.samples(src, at, first, m, i.size, d, &ch)?;
+                    objects[k].data.extend_from_slice(&v);
+                    first += m;
+                }
+            }
+            p += i.bytes;
+        }
+    }
+    Ok(())
+}
+
+/// Interleaved raw data: rows of one value of every channel. The in-order reading of
+/// chunk after chunk, channel after channel, is kept for its errors: the channels before
+/// the first of unequal count or variable size are read from the first chunk, and the
+/// first channel to fail (a 64-bit integer `f64` cannot hold) is the one reported.
+fn interleaved_data<S: Source + ?Sized>(
+    src: &S,
+    r: &Raw,
+    c: &Cursor,
+    present: &[(usize, RawIndex)],
+    chunk: u64,
+    chunks: u64,
+    objects: &mut [Object],
+) -> Result<(), ReadError> {
+    let count = present[0].1.count;
+    let row: u64 = present.iter().map(|(_, i)| i.size).sum();
+    let bad = present
+        .iter()
+        .position(|(_, i)| i.count != count || i.size == 0);
+    // The columns read: channel, its byte within the row, its type and name.
+    let mut cols = Vec::new();
+    let mut col = 0;
+    for &(k, i) in &present[..bad.unwrap_or(present.len())] {
+        if let Some(d) = i.dtype {
+            cols.push((k, col, d, objects[k].path.join("/")));
+        }
+        col += i.size;
+    }
+    let chunks = if bad.is_some() { 1 } else { chunks };
+    if bad.is_none() {
+        for (k, ..) in &cols {
+            objects[*k]
+                .data
+                .reserve(count.saturating_mul(chunks) as usize);
+        }
+    }
+    let per = (BLOCK / row.max(1)).max(1);
+    for n in 0..chunks {
+        let base = r.start + n * chunk;
+        // The first failing column of this chunk, and its error.
+        let mut failed: Option<(usize, ReadError)> = None;
+        let mut first = 0;
+        while first < count {
+            let m = per.min(count - first);
+            let at = base + first * row;
+            for (j, (k, col, d, ch)) in cols.iter().enumerate() {
+                if failed.as_ref().is_some_and(|(f, _)| *f <= j) {
+                    break;
+                }
+                match r.samples(src, at + col, first, m, row, *d, ch) {
+                    Ok(v) => objects[*k].data.extend_from_slice(&v),
+                    Err(err @ ReadError::Io { .. }) => return Err(err),
+                    Err(err) => failed = Some((j, err)),
+                }
+            }
+            first += m;
+        }
+        if let Some((_, err)) = failed {
+            return Err(err);
+        }
+    }
+    if let Some(j) = bad {
+        let (k, i) = present[j];
+        return Err(c.invalid(
+            "TDMS interleaved raw data",
+            format!(
+                "{} with {} values of {} bytes",
+                objects[k].path.join("/"),
+                i.count,
+                i.size
+            ),
+            format!("every channel with {count} fixed-size values"),
+        ));
     }
     Ok(())
 }
@@ -475,5 +627,110 @@ mod tests {
         );
         assert_eq!(split_path("/g"), None);
         assert_eq!(split_path("/'g"), None);
+    }
+
+    /// A one-segment file of channels `(name, type code, value count)` whose raw data is
+    /// `raw`, little endian.
+    fn segment(toc: u32, channels: &[(&str, u32, u64)], raw: &[u8]) -> Vec<u8> {
+        let mut meta = Vec::new();
+        meta.extend((channels.len() as u32).to_le_bytes());
+        for &(name, t, count) in channels {
+            let path = format!("/'g'/'{name}'");
+            meta.extend((path.len() as u32).to_le_bytes());
+            meta.extend(path.as_bytes());
+            meta.extend(20u32.to_le_bytes());
+            meta.extend(t.to_le_bytes());
+            meta.extend(1u32.to_le_bytes());
+            meta.extend(count.to_le_bytes());
+            meta.extend(0u32.to_le_bytes());
+        }
+        let mut f = b"TDSm".to_vec();
+        f.extend((toc | TOC_META | TOC_NEW_LIST | TOC_RAW).to_le_bytes());
+        f.extend(4713u32.to_le_bytes());
+        f.extend(((meta.len() + raw.len()) as u64).to_le_bytes());
+        f.extend((meta.len() as u64).to_le_bytes());
+        f.extend(meta);
+        f.extend(raw);
+        f
+    }
+
+    /// Reads `bytes` in memory and from disk, which must agree.
+    fn both(bytes: &[u8]) -> Result<Table, ReadError> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.tdms");
+        std::fs::write(&path, bytes).unwrap();
+        let mem = read("x.tdms", bytes);
+        let disk = read_file("x.tdms", &path);
+        assert_eq!(format!("{mem:?}"), format!("{disk:?}"));
+        mem
+    }
+
+    #[test]
+    fn channels_longer_than_a_block_are_read_whole_and_errors_count_from_the_chunk() {
+        // two chunks of an f64 channel of 40 000 values and an i64 channel of 100 000
+        let (na, nb) = (40_000u64, 100_000u64);
+        let mut raw = Vec::new();
+        for chunk in 0..2u64 {
+            for k in 0..na {
+                raw.extend(((chunk * na + k) as f64 * 0.5).to_le_bytes());
+            }
+            for k in 0..nb {
+                raw.extend(((chunk * nb + k) as i64 - 7).to_le_bytes());
+            }
+        }
+        let ch = [("a", 10, na), ("b", 4, nb)];
+        let t = both(&segment(0, &ch, &raw)).unwrap();
+        let a: Vec<f64> = (0..2 * na).map(|k| k as f64 * 0.5).collect();
+        let b: Vec<f64> = (0..2 * nb).map(|k| k as f64 - 7.0).collect();
+        assert_eq!(t.channels[0].data, a);
+        assert_eq!(t.channels[1].data, b);
+        // an i64 f64 cannot hold, 70 000 values into the second chunk's b
+        let at = (2 * na + nb + 70_000) as usize * 8;
+        raw[at..at + 8].copy_from_slice(&((1i64 << 60) + 1).to_le_bytes());
+        let f = segment(0, &ch, &raw);
+        let raw_start = (f.len() - raw.len()) as u64;
+        match both(&f) {
+            Err(ReadError::InexactInteger { index, offset, .. }) => {
+                assert_eq!(index, 70_000);
+                assert_eq!(offset, raw_start + at as u64);
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn interleaved_rows_longer_than_a_block_are_read_whole() {
+        // an i32 and an i64 channel of 100 000 values each, value by value
+        let n = 100_000u64;
+        let mut raw = Vec::new();
+        for k in 0..n {
+            raw.extend((k as i32 * 3).to_le_bytes());
+            raw.extend((k as i64 - 5).to_le_bytes());
+        }
+        let ch = [("a", 3, n), ("b", 4, n)];
+        let t = both(&segment(TOC_INTERLEAVED, &ch, &raw)).unwrap();
+        let a: Vec<f64> = (0..n).map(|k| (k * 3) as f64).collect();
+        let b: Vec<f64> = (0..n).map(|k| k as f64 - 5.0).collect();
+        assert_eq!(t.channels[0].data, a);
+        assert_eq!(t.channels[1].data, b);
+        // b's value 90 000 is an i64 f64 cannot hold, and later a's 95 000 too: the
+        // first channel's is reported, as reading channel after channel would
+        let at_b = 90_000 * 12 + 4;
+        raw[at_b..at_b + 8].copy_from_slice(&((1i64 << 60) + 1).to_le_bytes());
+        let f = segment(TOC_INTERLEAVED, &[("a", 4, n), ("b", 4, n)], &{
+            let mut r = Vec::new();
+            for k in 0..n as usize {
+                let a = if k == 95_000 { (1i64 << 60) + 3 } else { 0 };
+                r.extend(a.to_le_bytes());
+                r.extend_from_slice(&raw[k * 12 + 4..k * 12 + 12]);
+            }
+            r
+        });
+        match both(&f) {
+            Err(ReadError::InexactInteger { channel, index, .. }) => {
+                assert_eq!((channel.as_str(), index), ("g/a", 95_000));
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }
