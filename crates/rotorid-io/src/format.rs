@@ -74,6 +74,7 @@ pub fn read_table(path: impl AsRef<Path>) -> Result<Table, ReadError> {
         Format::Npz => return crate::npz::read_file(&file, path),
         Format::Mat => return crate::mat::read_file(&file, path),
         Format::Tdms => return crate::tdms::read_file(&file, path),
+        Format::Uff58 => return crate::uff::read_file(&file, path),
         _ => {}
     }
     let bytes = std::fs::read(path).map_err(|source| ReadError::Io {

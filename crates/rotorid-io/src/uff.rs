@@ -24,6 +24,8 @@
 //! uneven abscissa spacing, an abscissa that is not time, a point count that differs from
 //! the data, binary formats other than IEEE 754, non-UTF-8 header text.
 
+use std::io::{BufRead, Read};
+
 use crate::cursor::Cursor;
 use crate::error::ReadError;
 use crate::num::{Dtype, Endian};
@@ -31,15 +33,197 @@ use crate::table::{Channel, Table, TimeAxis};
 
 /// Reads a UFF file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
-    let mut c = Cursor::new(file, bytes);
+    read_from(file, bytes, bytes.len() as u64)
+}
+
+/// Reads the UFF file at `path` line by line (an ASCII record's values go straight into
+/// its channel), a 58b record's binary data a block at a time: memory holds the channels,
+/// a line and a block, never the whole file. Accepts and refuses what [`read`] does, with
+/// the same messages.
+pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
+    let disk = crate::format::DiskFile::open(file, path)?;
+    let input = std::io::BufReader::with_capacity(1 << 16, disk.handle()?);
+    read_from(file, input, disk.size)
+}
+
+/// Bytes of 58b binary data read at a time.
+const BLOCK: u64 = 1 << 18;
+
+/// The lines of a UFF file of `size` bytes read from `input`, with their file offsets; the
+/// last line can be handed out again ([`Lines::unread`]). Errors name the file and the
+/// channel being read.
+struct Lines<'a, R> {
+    file: &'a str,
+    channel: Option<String>,
+    input: R,
+    size: u64,
+    /// File offset of the next byte of `input`.
+    pos: u64,
+    /// The last line read, with its line end, and its offset.
+    buf: Vec<u8>,
+    at: u64,
+    /// The last line is the next one.
+    again: bool,
+}
+
+impl<'a, R: BufRead> Lines<'a, R> {
+    /// Moves to the next line and returns its offset (the line is [`Lines::last`]); `None`
+    /// at the end.
+    fn next(&mut self) -> Result<Option<u64>, ReadError> {
+        if !self.again {
+            self.buf.clear();
+            let n = self
+                .input
+                .read_until(b'\n', &mut self.buf)
+                .map_err(|e| self.io(e))?;
+            if n == 0 {
+                return Ok(None);
+            }
+            self.at = self.pos;
+            self.pos += n as u64;
+        }
+        self.again = false;
+        Ok(Some(self.at))
+    }
+
+    /// The line [`Lines::next`] moved to, without `\n` or `\r\n`.
+    fn last(&self) -> &[u8] {
+        let l = self.buf.strip_suffix(b"\n").unwrap_or(&self.buf);
+        l.strip_suffix(b"\r").unwrap_or(l)
+    }
+
+    /// Hands out the last line again.
+    fn unread(&mut self) {
+        self.again = true;
+    }
+
+    /// File offset of the next line.
+    fn offset(&self) -> u64 {
+        if self.again {
+            self.at
+        } else {
+            self.pos
+        }
+    }
+
+    fn remaining(&self) -> u64 {
+        self.size.saturating_sub(self.offset())
+    }
+
+    fn io(&self, source: std::io::Error) -> ReadError {
+        ReadError::Io {
+            file: self.file.to_string(),
+            source,
+        }
+    }
+
+    /// Steps over `n` bytes (right after a line: none is to be handed out again).
+    fn skip(&mut self, n: u64, what: &str) -> Result<(), ReadError> {
+        if n > self.remaining() {
+            return Err(self.truncated(what, n));
+        }
+        let got = std::io::copy(&mut (&mut self.input).take(n), &mut std::io::sink())
+            .map_err(|e| self.io(e))?;
+        self.pos += got;
+        if got < n {
+            return Err(self.io(std::io::ErrorKind::UnexpectedEof.into()));
+        }
+        Ok(())
+    }
+
+    /// `npts` values of `t` in byte order `e` (right after a line), for the channel.
+    fn samples(&mut self, npts: u64, t: Dtype, e: Endian) -> Result<Vec<f64>, ReadError> {
+        let size = t.size() as u64;
+        let channel = self.channel.clone().unwrap_or_default();
+        let nbytes = npts.saturating_mul(size);
+        if nbytes > self.remaining() {
+            return Err(ReadError::Truncated {
+                file: self.file.to_string(),
+                channel: Some(channel),
+                offset: self.offset(),
+                what: format!("{npts} samples of {t:?}"),
+                need: nbytes,
+                available: self.remaining(),
+            });
+        }
+        let mut out = Vec::with_capacity(npts as usize);
+        let mut block = Vec::new();
+        let per = (BLOCK / size).max(1);
+        let mut done = 0;
+        while done < npts {
+            let m = per.min(npts - done);
+            block.resize((m * size) as usize, 0);
+            self.input.read_exact(&mut block).map_err(|e| self.io(e))?;
+            let c = Cursor {
+                base: self.pos,
+                ..Cursor::new(self.file, &block)
+            };
+            out.extend_from_slice(&c.samples(0, m, size, t, e, &channel)?);
+            self.pos += m * size;
+            done += m;
+        }
+        Ok(out)
+    }
+
+    /// The cursor's error for `need` bytes of `what` at the next line.
+    fn truncated(&self, what: &str, need: u64) -> ReadError {
+        ReadError::Truncated {
+            file: self.file.to_string(),
+            channel: self.channel.clone(),
+            offset: self.offset(),
+            what: what.to_string(),
+            need,
+            available: self.remaining(),
+        }
+    }
+
+    fn invalid_at(
+        &self,
+        at: u64,
+        what: &str,
+        found: impl ToString,
+        allowed: impl ToString,
+    ) -> ReadError {
+        ReadError::Invalid {
+            file: self.file.to_string(),
+            channel: self.channel.clone(),
+            offset: at,
+            what: what.to_string(),
+            found: found.to_string(),
+            allowed: allowed.to_string(),
+        }
+    }
+
+    fn not_utf8(&self, at: u64, what: &str, b: &[u8]) -> ReadError {
+        ReadError::NotUtf8 {
+            file: self.file.to_string(),
+            channel: self.channel.clone(),
+            offset: at,
+            what: what.to_string(),
+            bytes: b.iter().take(16).copied().collect(),
+        }
+    }
+}
+/// Reads the datasets of `input`, a UFF file of `size` bytes.
+fn read_from<R: BufRead>(file: &str, input: R, size: u64) -> Result<Table, ReadError> {
+    let mut c = Lines {
+        file,
+        channel: None,
+        input,
+        size,
+        pos: 0,
+        buf: Vec::new(),
+        at: 0,
+        again: false,
+    };
     let mut channels: Vec<Channel> = Vec::new();
     let mut other = Vec::new();
     loop {
         // Find the next "-1" delimiter, skipping blank lines.
-        let (at, l) = match line(&mut c) {
-            None => break,
-            Some(x) => x,
+        let Some(at) = c.next()? else {
+            break;
         };
+        let l = c.last();
         let t = trim(l);
         if t.is_empty() {
             continue;
@@ -47,16 +231,19 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
         if t != b"-1" {
             return Err(c.invalid_at(at, "UFF dataset delimiter", show(l), "a line \"    -1\""));
         }
-        let (hat, head) = line(&mut c).ok_or_else(|| c.truncated("UFF dataset number", 6))?;
-        let num = trim(head.get(..6).unwrap_or(head));
+        let hat = c
+            .next()?
+            .ok_or_else(|| c.truncated("UFF dataset number", 6))?;
+        let head = c.last().to_vec();
+        let num = trim(head.get(..6).unwrap_or(&head));
         let binary = head.get(6) == Some(&b'b');
         if num == b"-1" || num.is_empty() {
             // An empty dataset or a stray delimiter: the next line starts over.
-            c.pos = hat;
+            c.unread();
             continue;
         }
         if num == b"58" {
-            let ch = dataset58(&mut c, hat, head, binary)?;
+            let ch = dataset58(&mut c, hat, &head, binary)?;
             let mut name = ch.name.clone();
             let mut k = 1;
             while channels.iter().any(|x| x.name == name) {
@@ -66,7 +253,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
             channels.push(Channel { name, ..ch });
         } else {
             other.push(String::from_utf8_lossy(num).into_owned());
-            skip_dataset(&mut c, hat, head, binary)?;
+            skip_dataset(&mut c, hat, &head, binary)?;
         }
     }
     if channels.is_empty() {
@@ -93,21 +280,12 @@ fn trim(l: &[u8]) -> &[u8] {
     l.trim_ascii()
 }
 
-/// The next line (without `\n` or `\r\n`) and its buffer position; `None` at the end.
-fn line<'a>(c: &mut Cursor<'a>) -> Option<(usize, &'a [u8])> {
-    if c.at_end() {
-        return None;
-    }
-    let at = c.pos;
-    let rest = &c.data[at..];
-    let n = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
-    c.pos = (at + n + 1).min(c.data.len());
-    let l = &rest[..n];
-    Some((at, l.strip_suffix(b"\r").unwrap_or(l)))
-}
-
 /// The 58b header fields after `58b`: byte order, float format, ASCII lines, data bytes.
-fn binary_header(c: &Cursor, hat: usize, head: &[u8]) -> Result<(Endian, u64, u64), ReadError> {
+fn binary_header<R: BufRead>(
+    c: &Lines<R>,
+    hat: u64,
+    head: &[u8],
+) -> Result<(Endian, u64, u64), ReadError> {
     let text = std::str::from_utf8(head.get(7..).unwrap_or(b""))
         .map_err(|_| c.not_utf8(hat, "UFF binary header", head))?;
     let f: Vec<u64> = text
@@ -155,16 +333,22 @@ fn binary_header(c: &Cursor, hat: usize, head: &[u8]) -> Result<(Endian, u64, u6
 }
 
 /// Steps over a dataset other than 58, up to and including its closing `-1`.
-fn skip_dataset(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<(), ReadError> {
+fn skip_dataset<R: BufRead>(
+    c: &mut Lines<R>,
+    hat: u64,
+    head: &[u8],
+    binary: bool,
+) -> Result<(), ReadError> {
     if binary {
         let (_, lines, nbytes) = binary_header(c, hat, head)?;
         for _ in 0..lines {
-            line(c).ok_or_else(|| c.truncated("UFF binary dataset header line", 1))?;
+            c.next()?
+                .ok_or_else(|| c.truncated("UFF binary dataset header line", 1))?;
         }
         c.skip(nbytes, "UFF binary dataset data")?;
     }
-    while let Some((_, l)) = line(c) {
-        if trim(l) == b"-1" {
+    while c.next()?.is_some() {
+        if trim(c.last()) == b"-1" {
             return Ok(());
         }
     }
@@ -180,23 +364,23 @@ fn parse_number(w: &str) -> Option<f64> {
     }
 }
 
-fn field<'a>(
-    c: &Cursor,
-    at: usize,
-    l: &'a [u8],
+fn field<'l, R: BufRead>(
+    c: &Lines<R>,
+    at: u64,
+    l: &'l [u8],
     from: usize,
     to: usize,
     what: &str,
-) -> Result<&'a str, ReadError> {
+) -> Result<&'l str, ReadError> {
     let b = l.get(from.min(l.len())..to.min(l.len())).unwrap_or(b"");
     std::str::from_utf8(b)
         .map(str::trim)
-        .map_err(|_| c.not_utf8(at + from, what, b))
+        .map_err(|_| c.not_utf8(at + from as u64, what, b))
 }
 
-fn numbers<T: std::str::FromStr>(
-    c: &Cursor,
-    at: usize,
+fn numbers<T: std::str::FromStr, R: BufRead>(
+    c: &Lines<R>,
+    at: u64,
     l: &[u8],
     n: usize,
     what: &str,
@@ -215,12 +399,22 @@ fn numbers<T: std::str::FromStr>(
     Ok(v)
 }
 
-fn units(c: &Cursor, at: usize, l: &[u8], what: &str) -> Result<Option<String>, ReadError> {
+fn units<R: BufRead>(
+    c: &Lines<R>,
+    at: u64,
+    l: &[u8],
+    what: &str,
+) -> Result<Option<String>, ReadError> {
     let u = field(c, at, l, 47, 67, what)?;
     Ok((!u.is_empty() && !u.eq_ignore_ascii_case("NONE")).then(|| u.to_string()))
 }
 
-fn dataset58(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<Channel, ReadError> {
+fn dataset58<R: BufRead>(
+    c: &mut Lines<R>,
+    hat: u64,
+    head: &[u8],
+    binary: bool,
+) -> Result<Channel, ReadError> {
     let bin = if binary {
         Some(binary_header(c, hat, head)?)
     } else {
@@ -233,15 +427,19 @@ fn dataset58(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<Ch
     }
     let mut rec = Vec::with_capacity(11);
     for k in 1..=11 {
-        rec.push(line(c).ok_or_else(|| c.truncated(&format!("UFF 58 record {k}"), 1))?);
+        let at = c
+            .next()?
+            .ok_or_else(|| c.truncated(&format!("UFF 58 record {k}"), 1))?;
+        rec.push((at, c.last().to_vec()));
     }
-    let (at1, id1) = rec[0];
-    let mut name = field(c, at1, id1, 0, 80, "UFF 58 ID line 1 (the channel name)")?.to_string();
+    let (at1, id1) = &rec[0];
+    let mut name = field(c, *at1, id1, 0, 80, "UFF 58 ID line 1 (the channel name)")?.to_string();
     if name.is_empty() {
         name = format!("58@{hat}");
     }
     c.channel = Some(name.clone());
-    let (at7, r7) = rec[6];
+    let (at7, r7) = &rec[6];
+    let at7 = *at7;
     let head7: Vec<f64> = numbers(
         c,
         at7,
@@ -290,21 +488,21 @@ fn dataset58(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<Ch
     if !(npts >= 0.0 && npts.fract() == 0.0) {
         return Err(c.invalid_at(at7, "UFF 58 number of points", npts, "a whole number"));
     }
-    let (at8, r8) = rec[7];
-    let xtype = field(c, at8, r8, 0, 10, "UFF 58 abscissa data type")?;
+    let (at8, r8) = &rec[7];
+    let xtype = field(c, *at8, r8, 0, 10, "UFF 58 abscissa data type")?;
     if !matches!(xtype, "0" | "17" | "") {
         return Err(c.invalid_at(
-            at8,
+            *at8,
             "UFF 58 abscissa data type",
             xtype,
             "17 (time) or 0 (unknown)",
         ));
     }
-    let (at9, r9) = rec[8];
-    let (at10, r10) = rec[9];
+    let (at9, r9) = &rec[8];
+    let (at10, r10) = &rec[9];
     let unit = match (
-        units(c, at9, r9, "UFF 58 ordinate units")?,
-        units(c, at10, r10, "UFF 58 ordinate denominator units")?,
+        units(c, *at9, r9, "UFF 58 ordinate units")?,
+        units(c, *at10, r10, "UFF 58 ordinate denominator units")?,
     ) {
         (Some(n), Some(d)) => Some(format!("{n}/{d}")),
         (n, _) => n,
@@ -321,24 +519,25 @@ fn dataset58(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<Ch
                     format!("{npts} points of {size} bytes"),
                 ));
             }
-            let start_pos = c.pos;
-            let d = c.samples(start_pos, npts, size, dtype, e, &name)?;
-            c.pos += nbytes as usize;
-            d
+            c.samples(npts, dtype, e)?
         }
         None => {
-            let at = c.pos;
-            if npts > c.remaining() as u64 / 2 {
+            let at = c.offset();
+            if npts > c.remaining() / 2 {
                 return Err(c.truncated(
                     &format!("UFF 58 data of {npts} points"),
                     npts.saturating_mul(2),
                 ));
             }
+            // At most one value per two bytes left, checked above.
             let mut d = Vec::with_capacity(npts as usize);
             loop {
-                let (lat, l) = line(c).ok_or_else(|| c.truncated("UFF closing \"    -1\"", 6))?;
+                let lat = c
+                    .next()?
+                    .ok_or_else(|| c.truncated("UFF closing \"    -1\"", 6))?;
+                let l = c.last();
                 if trim(l) == b"-1" {
-                    c.pos = lat;
+                    c.unread();
                     break;
                 }
                 let text = std::str::from_utf8(l).map_err(|_| c.not_utf8(lat, "UFF 58 data", l))?;
@@ -371,7 +570,10 @@ fn dataset58(c: &mut Cursor, hat: usize, head: &[u8], binary: bool) -> Result<Ch
     };
     // The closing delimiter, possibly after the newline ending the binary data.
     loop {
-        let (lat, l) = line(c).ok_or_else(|| c.truncated("UFF closing \"    -1\"", 6))?;
+        let lat = c
+            .next()?
+            .ok_or_else(|| c.truncated("UFF closing \"    -1\"", 6))?;
+        let l = c.last();
         match trim(l) {
             b"" => continue,
             b"-1" => break,
