@@ -218,11 +218,8 @@ fn read_from<R: BufRead>(file: &str, input: R, size: u64) -> Result<Table, ReadE
     };
     let mut channels: Vec<Channel> = Vec::new();
     let mut other = Vec::new();
-    loop {
-        // Find the next "-1" delimiter, skipping blank lines.
-        let Some(at) = c.next()? else {
-            break;
-        };
+    // Find the next "-1" delimiter, skipping blank lines.
+    while let Some(at) = c.next()? {
         let l = c.last();
         let t = trim(l);
         if t.is_empty() {
