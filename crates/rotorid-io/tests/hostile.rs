@@ -156,12 +156,16 @@ fn huge_length_fields_never_allocate() {
 #[test]
 fn reading_from_disk_refuses_what_the_bytes_reader_refuses() {
     // `read_table` reads Parquet column chunk by column chunk, NPZ member by member, MAT
-    // level 5 element by element and MAT v7.3 in the HDF5 layer's streaming mode from disk
-    // (`*::read_file`); it must accept and refuse exactly what the in-memory readers do,
-    // with the same messages
+    // level 5 element by element, MAT v7.3 in the HDF5 layer's streaming mode, TDMS segment
+    // by segment and UFF line by line from disk (`*::read_file`); it must accept and refuse
+    // exactly what the in-memory readers do, with the same messages, and allocate no more
+    // at once
     let dir = tempfile::tempdir().unwrap();
     for (path, format, bytes) in fixtures() {
-        if !matches!(format, Format::Parquet | Format::Npz | Format::Mat) {
+        if !matches!(
+            format,
+            Format::Parquet | Format::Npz | Format::Mat | Format::Tdms | Format::Uff58
+        ) {
             continue;
         }
         let name = path.file_name().unwrap().to_string_lossy().to_string();
@@ -179,7 +183,14 @@ fn reading_from_disk_refuses_what_the_bytes_reader_refuses() {
             let len = b.len();
             std::fs::write(&on_disk, &b).unwrap();
             let mem = read_bytes(format, &on_disk_name, &b);
+            PEAK.with(|p| p.set(0));
             let disk = rotorid_io::read_table(&on_disk);
+            let peak = PEAK.with(|p| p.get());
+            let limit = allowed(format, &name, len);
+            assert!(
+                peak <= limit,
+                "{name} ({len} bytes) from disk: allocated {peak} bytes at once, allowed {limit}"
+            );
             match (mem, disk) {
                 (Ok(a), Ok(b)) => assert_eq!(a, b, "{name}"),
                 // MAT v7.3 goes through the HDF5 layer's streaming mode from disk: it reads
@@ -202,6 +213,51 @@ fn reading_from_disk_refuses_what_the_bytes_reader_refuses() {
                 }
                 (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{name}"),
                 (a, b) => panic!("{name} ({len} bytes): in memory {a:?}, from disk {b:?}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn reading_tdms_and_uff_from_disk_refuses_huge_lengths_alike() {
+    // the streaming TDMS and UFF readers check a length against the bytes left in the
+    // file before reading that many: 4-byte windows set to huge lengths must be refused as
+    // the in-memory readers refuse them (every cut, every byte flipped and every aligned
+    // window of these fixtures were compared once too: 5 minutes, too slow for CI)
+    let dir = tempfile::tempdir().unwrap();
+    for (path, format, bytes) in fixtures() {
+        if !matches!(format, Format::Tdms | Format::Uff58) {
+            continue;
+        }
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let on_disk = dir.path().join(&name);
+        let on_disk_name = on_disk.display().to_string();
+        let check = |b: &[u8]| {
+            std::fs::write(&on_disk, b).unwrap();
+            let mem = read_bytes(format, &on_disk_name, b);
+            let disk = rotorid_io::read_table(&on_disk);
+            match (mem, disk) {
+                // as text: a changed byte may make a sample NaN
+                (Ok(a), Ok(d)) => assert_eq!(format!("{a:?}"), format!("{d:?}"), "{name}"),
+                (Err(a), Err(d)) => assert_eq!(a.to_string(), d.to_string(), "{name}"),
+                (a, d) => panic!(
+                    "{name} ({} bytes): in memory {a:?}, from disk {d:?}",
+                    b.len()
+                ),
+            }
+        };
+        let step = ((bytes.len() / 100).max(4)) & !3;
+        let mut b = bytes.clone();
+        for i in (0..bytes.len().saturating_sub(8)).step_by(step) {
+            let saved: [u8; 8] = b[i..i + 8].try_into().unwrap();
+            for v in [0x7fff_ffffu32, 0xffff_fff0] {
+                b[i..i + 4].copy_from_slice(&v.to_le_bytes());
+                check(&b);
+                b[i..i + 4].copy_from_slice(&v.to_be_bytes());
+                check(&b);
+                b[i..i + 8].copy_from_slice(&(u64::from(v) << 20).to_le_bytes());
+                check(&b);
+                b[i..i + 8].copy_from_slice(&saved);
             }
         }
     }
