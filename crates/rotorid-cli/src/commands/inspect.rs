@@ -1,6 +1,9 @@
 //! `rotorid inspect FILE`: the channels of a record in any format rotorid reads, with
 //! their length, unit, sample rate and range, so a user can pick `--columns`.
 
+use std::fmt::Write as _;
+use std::io::Write as _;
+
 use crate::io::tables;
 
 /// Arguments of `rotorid inspect`.
@@ -11,16 +14,21 @@ pub struct InspectArgs {
     pub file: String,
 }
 
-/// Run `rotorid inspect`: one line per channel on stdout.
+/// Run `rotorid inspect`: one line per channel on stdout (a reader that goes away,
+/// `rotorid inspect FILE | head -3`, ends the run quietly).
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
     let table = tables::read(&args.file)?;
-    println!(
+    let mut out = String::new();
+    // (writing to a String cannot fail)
+    let _ = writeln!(
+        out,
         "{}: {} channel{}",
         table.file,
         table.channels.len(),
         if table.channels.len() == 1 { "" } else { "s" }
     );
-    println!(
+    let _ = writeln!(
+        out,
         "  {:<28} {:>10} {:<8} {:>14} {:>14} {:>14}",
         "channel", "samples", "unit", "rate [Hz]", "min", "max"
     );
@@ -40,7 +48,8 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
                 (lo.min(v), hi.max(v))
             });
         let nan = c.data.iter().filter(|v| v.is_nan()).count();
-        println!(
+        let _ = writeln!(
+            out,
             "  {:<28} {:>10} {:<8} {:>14} {:>14} {:>14}{}",
             c.name,
             c.data.len(),
@@ -64,5 +73,12 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
             }
         );
     }
-    Ok(())
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(out.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        r => r.map_err(|e| anyhow::anyhow!("cannot write to stdout: {e}")),
+    }
 }

@@ -212,6 +212,26 @@ fn estimates_as_parquet_hold_the_csv_values_and_nulls_where_it_is_empty() {
 }
 
 #[test]
+fn inspect_into_a_closed_pipe_ends_quietly() {
+    // `rotorid inspect FILE | head -1`: head has gone when rotorid writes (the pipe's read
+    // end is closed before rotorid starts, so the write surely fails with EPIPE)
+    let fixture = format!(
+        "{}/../rotorid-io/fixtures/ident.parquet",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = std::process::Command::new(assert_cmd::cargo::cargo_bin!("rotorid"))
+        .args(["inspect", &fixture])
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?}: {stderr}", out.status);
+    assert!(stderr.is_empty(), "nothing on stderr: {stderr}");
+}
+
+#[test]
 fn columns_pick_channels_by_other_names_and_inspect_lists_them() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("r.csv");
