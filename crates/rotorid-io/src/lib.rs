@@ -10,10 +10,14 @@
 //! [`read_table`] picks the reader by the file's extension ([`Format::from_path`]):
 //! [`mat`] (`.mat`, level 5 and v7.3), [`tdms`], [`uff`] (`.uff`, `.unv`, `.58`), [`npy`],
 //! [`npz`], [`parquet`] and CSV ([`csv::read_csv_table`]; the response CSV is also streamed
-//! by [`csv::ResponseReader`]). Every binary reader takes the whole file's bytes, checks
-//! each length and dimension field against them before allocating, and fails with a
-//! [`ReadError`] that names the file, the channel and the byte offset; none panics on any
-//! input (each has a cargo-fuzz target in `fuzz/`).
+//! by [`csv::ResponseReader`]). Every binary reader checks each length and dimension field
+//! against the bytes the file has left before allocating, and fails with a [`ReadError`]
+//! that names the file, the channel and the byte offset; none panics on any input (each
+//! has a cargo-fuzz target in `fuzz/`). Each reads the file's bytes in memory (`read`, for
+//! bytes already held) or from disk piece by piece (`read_file`, what [`read_table`] uses:
+//! Parquet column chunks, NPZ members, MAT level 5 elements, MAT v7.3 through the HDF5
+//! layer's streaming mode, TDMS segments, UFF58 lines), so memory holds the channels and
+//! one piece (about 1.3x the channels at most); both accept and refuse alike.
 //!
 //! [`write_table`] writes a table back as NPZ, MAT level 5 or Parquet ([`mod@write`]).
 //!
@@ -25,8 +29,9 @@
 //!
 //! [`csv`] reads the response CSV that `rotorid simulate` writes (and any CSV with the
 //! same columns, units in its header converted), streaming, at close to the speed the file
-//! can be read: records split in place, numbers parsed bit for bit as `str::parse` parses
-//! them and written in shortest round-trip form.
+//! can be read: a plain line parsed in one pass (`csv::columns::one_pass`), any other split
+//! in place, numbers parsed bit for bit as `str::parse` parses them and written in shortest
+//! round-trip form.
 
 // ReadError carries the file, channel, offset, found and allowed values inline so callers can
 // match on them; it is returned once per failed read, so its size costs nothing measurable.
