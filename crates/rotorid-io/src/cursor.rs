@@ -85,14 +85,14 @@ impl<'a> Cursor<'a> {
         found: impl ToString,
         allowed: impl ToString,
     ) -> ReadError {
-        ReadError::Invalid {
-            file: self.file.to_string(),
-            channel: self.channel.clone(),
-            offset: self.offset_of(pos),
-            what: self.describe(what, pos),
-            found: found.to_string(),
-            allowed: allowed.to_string(),
-        }
+        ReadError::invalid(
+            self.file,
+            self.channel.clone(),
+            self.offset_of(pos),
+            self.describe(what, pos),
+            found,
+            allowed,
+        )
     }
 
     pub fn invalid(&self, what: &str, found: impl ToString, allowed: impl ToString) -> ReadError {

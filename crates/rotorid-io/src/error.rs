@@ -132,6 +132,26 @@ pub enum ReadError {
 }
 
 impl ReadError {
+    /// [`ReadError::Invalid`]: field `what` at byte `offset` of `file` (in `channel`) holds
+    /// `found` where `allowed` is allowed.
+    pub(crate) fn invalid(
+        file: &str,
+        channel: Option<String>,
+        offset: u64,
+        what: String,
+        found: impl ToString,
+        allowed: impl ToString,
+    ) -> Self {
+        ReadError::Invalid {
+            file: file.to_string(),
+            channel,
+            offset,
+            what,
+            found: found.to_string(),
+            allowed: allowed.to_string(),
+        }
+    }
+
     /// The file the error is about.
     pub fn file(&self) -> &str {
         match self {

@@ -184,14 +184,14 @@ impl<'a, R: BufRead> Lines<'a, R> {
         found: impl ToString,
         allowed: impl ToString,
     ) -> ReadError {
-        ReadError::Invalid {
-            file: self.file.to_string(),
-            channel: self.channel.clone(),
-            offset: at,
-            what: what.to_string(),
-            found: found.to_string(),
-            allowed: allowed.to_string(),
-        }
+        ReadError::invalid(
+            self.file,
+            self.channel.clone(),
+            at,
+            what.to_string(),
+            found,
+            allowed,
+        )
     }
 
     fn not_utf8(&self, at: u64, what: &str, b: &[u8]) -> ReadError {
