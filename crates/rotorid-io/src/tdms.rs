@@ -70,7 +70,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 }
 
 /// Reads the TDMS file at `path` segment by segment: its lead-in, its metadata, then its
-/// raw data a block of at most [`BLOCK`] bytes at a time, each channel's samples appended
+/// raw data a block of at most `BLOCK` (256 KiB) bytes at a time, each channel's samples appended
 /// as they are read; memory holds the channels, one segment's metadata and one block,
 /// never the whole file. Accepts and refuses what [`read`] does, with the same messages.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {

@@ -218,7 +218,7 @@ impl<R: Read> ResponseReader<R> {
 
     /// The next validated row, or `None` at the end of the input.
     ///
-    /// A line without quotes is first parsed in one pass ([`fast_row`]); a line that pass
+    /// A line without quotes is first parsed in one pass (`columns::one_pass`); a line that pass
     /// does not take (blanks around a field, a bad or non-finite number, a wrong field
     /// count, ...) is split and checked field by field, which gives the same values and
     /// names what is wrong.
