@@ -5,6 +5,24 @@
 
 use clap::{Parser, Subcommand};
 
+/// `println!` that returns an error instead of panicking when stdout cannot be written:
+/// [`io::StdoutClosed`] when its reader went away (`rotorid analyze ... | head -1`), which
+/// `main` ends quietly.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*).map_err(crate::io::stdout_error)
+    }};
+}
+
+/// `print!` as [`outln!`] is `println!`.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($arg)*).map_err(crate::io::stdout_error)
+    }};
+}
+
 mod commands;
 mod io;
 mod plot;
@@ -60,6 +78,10 @@ fn main() {
         Command::Fleet(args) => commands::fleet::run(args),
     };
     if let Err(err) = result {
+        if err.is::<io::StdoutClosed>() {
+            // the reader of our output went away (`| head`): nothing more to say
+            std::process::exit(0);
+        }
         eprintln!("Error: {err:#}");
         std::process::exit(1);
     }

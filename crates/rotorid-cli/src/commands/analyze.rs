@@ -500,38 +500,38 @@ pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
     } else {
         "no covariance: no standard deviations"
     };
-    println!("rotor from {source} ({uncertainty})");
+    outln!("rotor from {source} ({uncertainty})")?;
     let g = args.rpm;
-    println!("critical speeds ({}-{} rpm):", g.start, g.stop);
+    outln!("critical speeds ({}-{} rpm):", g.start, g.stop)?;
     if r.critical.is_empty() {
-        println!("  none");
+        outln!("  none")?;
     }
     for (n, c) in r.critical.iter().enumerate() {
-        println!(
+        outln!(
             "  {}: {}  {}  (log dec {})",
             n + 1,
             with_std(c.rpm(), c.std_rpm(), "rpm"),
             whirl_name(c.whirl()),
             c.at.log_dec.map_or("-".into(), |d| format!("{d:.4}"))
-        );
+        )?;
     }
     match (r.stability.threshold, r.stability.min_log_dec) {
-        (None, Some(d)) => println!(
+        (None, Some(d)) => outln!(
             "stability: stable over the range; minimum log decrement {d:.4} ({} mode at {:.0} rpm)",
             ["lower", "higher"][r.stability.min_log_dec_mode.unwrap_or(0).min(1)],
             rad_per_s_to_rpm(r.stability.min_log_dec_speed.unwrap_or(0.0))
-        ),
-        (None, None) => println!("stability: stable over the range"),
-        (Some(t), _) => println!(
+        )?,
+        (None, None) => outln!("stability: stable over the range")?,
+        (Some(t), _) => outln!(
             "stability: UNSTABLE from {:.1} rpm (a mode's log decrement is negative; the model is stable whenever cx, cz > 0)",
             rad_per_s_to_rpm(t)
-        ),
+        )?,
     }
-    println!(
+    outln!(
         "wrote {}: analysis.json, {}, report.html",
         args.out.display(),
         figures.join(", ")
-    );
+    )?;
     Ok(())
 }
 

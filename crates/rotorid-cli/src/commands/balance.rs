@@ -216,7 +216,7 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
              (--reference RUN1.csv --trial RUN2.csv --trial-mass KG --trial-angle DEG --radius R)"
         ),
     };
-    print(&result);
+    // the file first: a reader of stdout that goes away ends the run at the print
     if let Some(path) = &args.out {
         let mut out = Output::create(&path.display().to_string(), FileMode::Atomic)?;
         serde_json::to_writer_pretty(&mut out, &result)
@@ -224,38 +224,43 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
         std::io::Write::write_all(&mut out, b"\n")?;
         out.commit()?;
     }
-    Ok(())
+    print(&result)
 }
 
-fn print(r: &BalanceJson) {
+fn print(r: &BalanceJson) -> anyhow::Result<()> {
     let std = match (r.std_mass_kg, r.std_angle_deg) {
         (Some(m), Some(a)) => format!(" (std {m:.2e} kg, {a:.3} deg)"),
         (Some(m), None) => format!(" (std {m:.2e} kg)"),
         _ => String::new(),
     };
-    println!(
+    outln!(
         "correction: {:.4e} kg ({:.4} g) at {:.2} deg, radius {} m{std}",
         r.mass_kg,
         r.mass_kg * 1e3,
         r.angle_deg,
         r.radius_m
-    );
-    println!("angles: {ANGLE_REFERENCE}");
+    )?;
+    outln!("angles: {ANGLE_REFERENCE}")?;
     if let (Some(u), Some(red)) = (r.residual_unbalance_kg_m, r.predicted_reduction) {
-        println!("predicted residual unbalance {u:.3e} kg m: 1X amplitude reduced {red:.0}x");
+        outln!("predicted residual unbalance {u:.3e} kg m: 1X amplitude reduced {red:.0}x")?;
     }
     if let Some(s) = &r.at_speed {
         match &s.after_um_pp {
-            Some(a) => println!(
+            Some(a) => {
+                outln!(
                 "at {:.1} rpm: 1X x {:.4} -> {:.4} um pk-pk, z {:.4} -> {:.4} um pk-pk (predicted)",
                 s.rpm, s.before_um_pp.x, a.x, s.before_um_pp.z, a.z
-            ),
-            None => println!(
+            )?
+            }
+            None => outln!(
                 "at {:.1} rpm: 1X x {:.4}, z {:.4} um pk-pk before the correction",
-                s.rpm, s.before_um_pp.x, s.before_um_pp.z
-            ),
+                s.rpm,
+                s.before_um_pp.x,
+                s.before_um_pp.z
+            )?,
         }
     }
+    Ok(())
 }
 
 fn from_summary(args: &BalanceArgs) -> anyhow::Result<BalanceJson> {

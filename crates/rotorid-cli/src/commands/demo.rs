@@ -100,9 +100,9 @@ pub struct DemoReport {
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let report = compute()?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?)?;
     } else {
-        print!("{}", render(&report));
+        out!("{}", render(&report))?;
     }
     Ok(())
 }

@@ -36,6 +36,6 @@ pub fn run(args: FleetArgs) -> anyhow::Result<()> {
         let fleet = Fleet::connect(&nats, Duration::from_secs(5)).await?;
         rotorid_fleet::status::status(&fleet, &durable).await
     })?;
-    print!("{}", rotorid_fleet::status::render(&status));
+    out!("{}", rotorid_fleet::status::render(&status))?;
     Ok(())
 }

@@ -2,7 +2,6 @@
 //! their length, unit, sample rate and range, so a user can pick `--columns`.
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 
 use crate::io::tables;
 
@@ -14,8 +13,7 @@ pub struct InspectArgs {
     pub file: String,
 }
 
-/// Run `rotorid inspect`: one line per channel on stdout (a reader that goes away,
-/// `rotorid inspect FILE | head -3`, ends the run quietly).
+/// Run `rotorid inspect`: one line per channel on stdout.
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
     let table = tables::read(&args.file)?;
     let mut out = String::new();
@@ -73,12 +71,6 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
             }
         );
     }
-    let mut stdout = std::io::stdout().lock();
-    match stdout
-        .write_all(out.as_bytes())
-        .and_then(|()| stdout.flush())
-    {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        r => r.map_err(|e| anyhow::anyhow!("cannot write to stdout: {e}")),
-    }
+    out!("{out}")?;
+    Ok(())
 }

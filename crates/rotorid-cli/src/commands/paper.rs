@@ -168,15 +168,15 @@ pub fn run(args: PaperArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
 
     if !args.quiet {
-        println!(
+        outln!(
             "wrote {} figures (PNG and SVG), results.json, report.md and report.html to {}",
             report.figures.len(),
             dir.display()
-        );
+        )?;
         for table in case_tables(&report) {
-            println!("{}:", table.title);
+            outln!("{}:", table.title)?;
             for s in &table.summary {
-                println!("  - {s}");
+                outln!("  - {s}")?;
             }
         }
     }

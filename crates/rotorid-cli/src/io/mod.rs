@@ -28,7 +28,9 @@ pub mod scenario;
 pub mod tables;
 
 pub use estimates_csv::{EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES_HEADER};
-pub use output::{check_distinct_files, is_broken_pipe, open_input, FileMode, Output};
+pub use output::{
+    check_distinct_files, is_broken_pipe, open_input, stdout_error, FileMode, Output, StdoutClosed,
+};
 pub use params::ParameterSet;
 pub use response_csv::{ResponseReader, ResponseWriter};
 pub use rotorid_io::csv::CsvError;

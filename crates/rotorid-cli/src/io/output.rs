@@ -311,6 +311,29 @@ pub fn is_broken_pipe(e: &anyhow::Error) -> bool {
     })
 }
 
+/// The reader of stdout went away (a broken pipe while printing a command's result):
+/// `main` ends the run quietly with success, as `cat` does under `head`.
+#[derive(Debug)]
+pub struct StdoutClosed;
+
+impl std::fmt::Display for StdoutClosed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("stdout was closed by its reader")
+    }
+}
+
+impl std::error::Error for StdoutClosed {}
+
+/// The error of a failed write to stdout (`outln!`, `out!`): [`StdoutClosed`] for a broken
+/// pipe, else the I/O error.
+pub fn stdout_error(e: io::Error) -> anyhow::Error {
+    if e.kind() == io::ErrorKind::BrokenPipe {
+        StdoutClosed.into()
+    } else {
+        anyhow::Error::new(e).context("cannot write to stdout")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

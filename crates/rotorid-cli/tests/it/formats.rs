@@ -212,23 +212,47 @@ fn estimates_as_parquet_hold_the_csv_values_and_nulls_where_it_is_empty() {
 }
 
 #[test]
-fn inspect_into_a_closed_pipe_ends_quietly() {
+fn printing_into_a_closed_pipe_ends_quietly() {
     // `rotorid inspect FILE | head -1`: head has gone when rotorid writes (the pipe's read
-    // end is closed before rotorid starts, so the write surely fails with EPIPE)
+    // end is closed before rotorid starts, so the write surely fails with EPIPE); the run
+    // ends with success and nothing on stderr, and what it writes to files is written
     let fixture = format!(
         "{}/../rotorid-io/fixtures/ident.parquet",
         env!("CARGO_MANIFEST_DIR")
     );
-    let (reader, writer) = std::io::pipe().unwrap();
-    drop(reader);
-    let out = std::process::Command::new(assert_cmd::cargo::cargo_bin!("rotorid"))
-        .args(["inspect", &fixture])
-        .stdout(writer)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{:?}: {stderr}", out.status);
-    assert!(stderr.is_empty(), "nothing on stderr: {stderr}");
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("balance.json");
+    let json_arg = json.to_str().unwrap();
+    let identified = data("identified_table1.json");
+    let runs: [&[&str]; 2] = [
+        &["inspect", &fixture],
+        &[
+            "balance",
+            &identified,
+            "--radius",
+            "0.15",
+            "--rpm",
+            "3000",
+            "--out",
+            json_arg,
+        ],
+    ];
+    for args in runs {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let out = std::process::Command::new(assert_cmd::cargo::cargo_bin!("rotorid"))
+            .args(args)
+            .stdout(writer)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {:?}: {stderr}", out.status);
+        assert!(stderr.is_empty(), "{args:?}: nothing on stderr: {stderr}");
+    }
+    assert!(
+        summary(&json)["mass_kg"].is_number(),
+        "balance.json written"
+    );
 }
 
 #[test]
