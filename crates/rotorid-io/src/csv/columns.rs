@@ -18,7 +18,7 @@ use std::io::Read;
 use super::error::{abbreviate, quote, CsvError, WriteFailure, QUOTE_CHARS};
 use super::lines::{LineTooLong, MAX_LINE_BYTES};
 use super::number::parse_f64;
-use super::records::{Record, RecordReader};
+use super::records::{RawRecord, Record, RecordReader};
 use crate::units::{conversion, split_unit, Conversion, Quantity, UnitError};
 
 /// The longest number field accepted, in bytes (the shortest round-trip text of any `f64`
@@ -270,6 +270,15 @@ pub fn next_record<'a, R: Read>(
 ) -> Result<Option<Record<'a>>, CsvError> {
     csv.next_record()
         .map_err(|e| io_error(file, &e.error, e.line))
+}
+
+/// The next record of `csv` as [`RecordReader::next_raw`](super::records::RecordReader::next_raw)
+/// gives it (a plain line unsplit), an I/O error named as [`next_record`] names it.
+pub fn next_raw<'a, R: Read>(
+    file: &str,
+    csv: &'a mut CsvReader<R>,
+) -> Result<Option<RawRecord<'a>>, CsvError> {
+    csv.next_raw().map_err(|e| io_error(file, &e.error, e.line))
 }
 
 /// The [`CsvError`] of an I/O error met at `line` of `file` (see [`next_record`]).

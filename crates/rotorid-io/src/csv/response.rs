@@ -35,7 +35,7 @@ use std::io::Read;
 use std::ops::Range;
 
 use super::columns::{
-    check_length, csv_reader, finite_field, io_error, next_record, one_pass, CsvReader, Header,
+    check_length, csv_reader, finite_field, next_raw, next_record, one_pass, CsvReader, Header,
 };
 use super::error::CsvError;
 use super::number::{format_f64, readable};
@@ -223,10 +223,8 @@ impl<R: Read> ResponseReader<R> {
     /// count, ...) is split and checked field by field, which gives the same values and
     /// names what is wrong.
     pub fn next_row(&mut self) -> Result<Option<ResponseRow>, CsvError> {
-        let raw = match self.csv.next_raw() {
-            Ok(Some(raw)) => raw,
-            Ok(None) => return Ok(None),
-            Err(e) => return Err(io_error(&self.file, &e.error, e.line)),
+        let Some(raw) = next_raw(&self.file, &mut self.csv)? else {
+            return Ok(None);
         };
         let rec = match raw {
             RawRecord::Line { text, line } => {

@@ -7,7 +7,7 @@
 use std::io::Read;
 
 use super::columns::{
-    check_length, csv_reader, io_error, next_record, number_field, one_pass, Header,
+    check_length, csv_reader, next_raw, next_record, number_field, one_pass, Header,
 };
 use super::error::CsvError;
 use super::records::{split_line, RawRecord};
@@ -48,12 +48,7 @@ fn read<R: Read>(file: &str, input: R, fast: bool) -> Result<Table, CsvError> {
     // the general path); any other goes field by field, which names what is wrong.
     let mut row = vec![0.0; channels.len()];
     let mut fields = Vec::with_capacity(channels.len());
-    loop {
-        let raw = match csv.next_raw() {
-            Ok(Some(raw)) => raw,
-            Ok(None) => break,
-            Err(e) => return Err(io_error(file, &e.error, e.line)),
-        };
+    while let Some(raw) = next_raw(file, &mut csv)? {
         let rec = match raw {
             RawRecord::Line { text, line } => {
                 let parsed = fast
