@@ -85,7 +85,8 @@ pub struct WorkerConfig {
     pub ack_wait: Duration,
     /// Deliveries after which a window is dead-lettered.
     pub max_deliveries: i64,
-    /// Print one line per window on stderr.
+    /// Print on stderr a line when a window is taken and one when it is done (just before
+    /// its acknowledgement), and every dead letter and alert.
     pub verbose: bool,
 }
 
@@ -320,6 +321,12 @@ impl Worker<'_> {
             }
         };
         self.stats.redelivered += u64::from(delivered > 1);
+        if self.cfg.verbose {
+            eprintln!(
+                "window {} of machine {} (stream seq {stream_seq}, delivery {delivered}) taken",
+                frame.window, frame.machine
+            );
+        }
         if delivered > self.cfg.max_deliveries {
             let r = dead(
                 &frame.machine,

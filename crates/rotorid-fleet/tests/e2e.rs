@@ -1,6 +1,6 @@
 //! End to end with a real nats-server: 20 machines x 10 s of 10 kHz data, two worker
-//! processes; one is SIGKILLed mid-run and restarted, the server is SIGKILLed and
-//! restarted once. Afterwards every window of every machine has exactly one result in
+//! processes; one is SIGKILLed while it holds an unacknowledged window, and restarted; the
+//! server is SIGKILLed and restarted once. Afterwards every window of every machine has exactly one result in
 //! ROTORID_IDENT, byte for byte the JSON of an offline `identify` of the same samples
 //! (cut here from the simulation, not from the frames), and ROTORID_LATEST holds each
 //! machine's last window.
@@ -58,7 +58,7 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
 
     let method = "modulating";
     let spawn = || spawn_worker(&url, "e2e", method, &scenarios, 3.0);
-    let a = spawn();
+    let a = spawn_watched_worker(&url, "e2e", method, &scenarios, 3.0);
     let b = spawn();
 
     let fleet = Fleet::connect(&url, Duration::from_secs(10)).await.unwrap();
@@ -95,12 +95,16 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
             }
         }
     };
-    // kill worker a in the middle of some window and start a new one
+    // kill worker a while it holds a window it has not acknowledged, and start a new one
     wait_for(total / 4).await;
-    let mut a = a;
-    a.kill();
+    let held = tokio::task::spawn_blocking(move || a.kill_while_holding(Duration::from_secs(60)))
+        .await
+        .unwrap();
     let a = spawn();
-    eprintln!("worker killed and restarted at {:?}", started.elapsed());
+    eprintln!(
+        "worker killed holding {held} and restarted at {:?}",
+        started.elapsed()
+    );
     wait_for(total / 2).await;
     server.restart();
     eprintln!("server restarted at {:?}", started.elapsed());
@@ -133,7 +137,7 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
         "workers exit 0 on SIGTERM: {sa} {sb}"
     );
     eprintln!("worker a (restarted): {}worker b: {}", oa, ob);
-    // the killed worker held a window, or its pending pull got one: someone redid it
+    // the killed worker held a window unacknowledged: someone redid it
     let redelivered: u64 = [&oa, &ob]
         .iter()
         .map(|o| {

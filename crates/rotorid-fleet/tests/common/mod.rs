@@ -123,6 +123,116 @@ pub fn spawn_worker(url: &str, durable: &str, method: &str, dir: &Path, ack_wait
     Worker(Some(child))
 }
 
+/// A verbose worker (`ROTORID_FLEET_VERBOSE`) whose stderr the test reads, to know which
+/// window it holds.
+pub struct Watched {
+    worker: Worker,
+    /// Bytes of stderr read so far that do not yet end a line.
+    partial: Vec<u8>,
+    /// The last window it took and has not reported done (so not acknowledged).
+    holding: Option<String>,
+}
+
+pub fn spawn_watched_worker(
+    url: &str,
+    durable: &str,
+    method: &str,
+    dir: &Path,
+    ack_wait_s: f64,
+) -> Watched {
+    let child = Command::new(env!("CARGO_BIN_EXE_rotorid-fleet-worker"))
+        .args([url, durable, method])
+        .arg(dir)
+        .arg(ack_wait_s.to_string())
+        .env("ROTORID_FLEET_VERBOSE", "1")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the worker starts");
+    {
+        use std::os::fd::AsRawFd as _;
+        let fd = child.stderr.as_ref().expect("piped").as_raw_fd();
+        // SAFETY: fcntl on a pipe descriptor this process owns
+        let ok = unsafe { libc::fcntl(fd, libc::F_SETFL, libc::O_NONBLOCK) };
+        assert_eq!(ok, 0, "stderr pipe made non-blocking");
+    }
+    Watched {
+        worker: Worker(Some(child)),
+        partial: Vec::new(),
+        holding: None,
+    }
+}
+
+impl Watched {
+    /// Read what the worker has written on stderr so far (all of it, once it is stopped).
+    fn drain(&mut self) {
+        use std::io::Read as _;
+        let child = self.worker.0.as_mut().expect("a running worker");
+        let err = child.stderr.as_mut().expect("piped");
+        let mut buf = [0u8; 4096];
+        loop {
+            match err.read(&mut buf) {
+                Ok(0) => break,
+                Ok(n) => self.partial.extend_from_slice(&buf[..n]),
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => break,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => panic!("reading the worker's stderr: {e}"),
+            }
+        }
+        while let Some(end) = self.partial.iter().position(|&b| b == b'\n') {
+            let line: Vec<u8> = self.partial.drain(..=end).collect();
+            let line = String::from_utf8_lossy(&line);
+            let what = line.split(" (stream").next().unwrap_or("").to_owned();
+            if line.trim_end().ends_with(" taken") {
+                self.holding = Some(what);
+            } else if line.trim_end().ends_with(" done") {
+                self.holding = None;
+            }
+        }
+    }
+
+    /// SIGKILL the worker at a moment it holds a window it has not acknowledged (so the
+    /// server must redeliver it), and return that window. Stops the worker (SIGSTOP), reads
+    /// everything it wrote, and either kills it or lets it go on (SIGCONT) and tries again.
+    /// A partly written "done" line still means "not acknowledged": the ack follows it.
+    pub fn kill_while_holding(mut self, within: std::time::Duration) -> String {
+        let start = std::time::Instant::now();
+        loop {
+            let pid = self.worker.0.as_ref().expect("a running worker").id() as i32;
+            // SAFETY: signals to our own child, which is not reaped yet
+            unsafe { libc::kill(pid, libc::SIGSTOP) };
+            // wait until it is stopped (WNOWAIT: an exit stays for the final wait)
+            let mut info: libc::siginfo_t = unsafe { std::mem::zeroed() };
+            // SAFETY: waitid on our own child, info is a valid out pointer
+            let r = unsafe {
+                libc::waitid(
+                    libc::P_PID,
+                    pid as libc::id_t,
+                    &mut info,
+                    libc::WSTOPPED | libc::WEXITED | libc::WNOWAIT,
+                )
+            };
+            assert_eq!(r, 0, "waiting for the worker to stop");
+            assert_eq!(
+                info.si_code,
+                libc::CLD_STOPPED,
+                "the worker ended before it could be killed holding a window"
+            );
+            self.drain();
+            if let Some(w) = self.holding.take() {
+                self.worker.kill();
+                return w;
+            }
+            unsafe { libc::kill(pid, libc::SIGCONT) };
+            assert!(
+                start.elapsed() < within,
+                "the worker never held an unacknowledged window in {within:?}"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(7));
+        }
+    }
+}
+
 /// SIGTERM the worker and wait for it; returns its exit status and stdout.
 pub fn terminate(mut w: Worker) -> (std::process::ExitStatus, String) {
     let mut child = w.0.take().expect("a running worker");
