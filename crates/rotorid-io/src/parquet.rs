@@ -86,6 +86,7 @@ fn read_inner<R: ChunkReader + 'static>(
     size: u64,
     chunk: &ChunkFn<'_>,
 ) -> Result<Table, ReadError> {
+    check_footer(file, size, chunk)?;
     let reader = SerializedFileReader::new(source).map_err(|e| err(file, None, e))?;
     let meta = reader.metadata();
     let schema = meta.file_metadata().schema_descr();
@@ -263,6 +264,45 @@ fn read_inner<R: ChunkReader + 'static>(
     })
 }
 
+/// Walks the Thrift footer (FileMetaData) the way the `parquet` crate will, before it
+/// does: the crate steps over an unknown field's list, set or map of booleans without
+/// reading a byte per element, so a count of 2^31 there costs it 2^31 empty iterations
+/// (seconds, from a footer of a few hundred bytes). Here such counts together must stay
+/// within the footer's length, every other element costs a byte or more, and nesting stops
+/// at 80 levels, so the crate's own parse of an accepted footer is linear in its length.
+/// A footer that does not end in `PAR1` is left to the crate's error.
+fn check_footer(file: &str, size: u64, chunk: &ChunkFn<'_>) -> Result<(), ReadError> {
+    if size < 12 {
+        return Ok(());
+    }
+    let tail = chunk(size - 8, 8)?;
+    if tail[4..] != *b"PAR1" {
+        return Ok(());
+    }
+    let len = u64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
+    if len > size - 8 {
+        return Ok(());
+    }
+    let start = size - 8 - len;
+    let bytes = chunk(start, len)?;
+    let mut t = Thrift::new(&bytes);
+    if t.skip(12, 0).is_none() {
+        return Err(ReadError::invalid(
+            file,
+            None,
+            start + t.i.min(bytes.len()) as u64,
+            "Parquet footer".into(),
+            "a malformed Thrift structure",
+            format!(
+                "a Thrift compact FileMetaData within the footer's {len} bytes, nested at most \
+                 {MAX_DEPTH} deep, whose containers of booleans hold at most {len} elements \
+                 together"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Walks the page headers of a column chunk of `len` bytes at `start` (in a file of `size`
 /// bytes, read by `chunk`), checking each page's sizes before the `parquet` crate
 /// allocates them.
@@ -303,10 +343,8 @@ fn check_pages(
     let bytes = chunk(start, len)?;
     let mut pos = start;
     while pos < end {
-        let mut t = Thrift {
-            b: &bytes,
-            i: (pos - start) as usize,
-        };
+        let mut t = Thrift::new(&bytes);
+        t.i = (pos - start) as usize;
         let (unc, comp) = t.page_header().ok_or_else(|| {
             bad(
                 pos,
@@ -342,14 +380,29 @@ fn check_pages(
     Ok(())
 }
 
+/// Deepest nesting of Thrift structures and containers walked (the `parquet` crate's skip
+/// allows 64 below the field it skips).
+const MAX_DEPTH: u32 = 80;
+
 /// Just enough of the Thrift compact protocol to read a PageHeader's sizes (fields 2 and 3)
-/// and step over the rest.
+/// and step over everything else exactly as the `parquet` crate's skip does, so that what
+/// this walk accepts the crate parses in time linear in its length: a boolean element of a
+/// list, set or map takes no byte there (the crate reads none), and such elements draw on
+/// a budget of `bools`, the walked bytes' length.
 struct Thrift<'a> {
     b: &'a [u8],
     i: usize,
+    bools: u64,
 }
 
-impl Thrift<'_> {
+impl<'a> Thrift<'a> {
+    fn new(b: &'a [u8]) -> Self {
+        Thrift {
+            b,
+            i: 0,
+            bools: b.len() as u64,
+        }
+    }
     fn byte(&mut self) -> Option<u8> {
         let v = *self.b.get(self.i)?;
         self.i += 1;
@@ -370,8 +423,13 @@ impl Thrift<'_> {
         let v = self.varint()?;
         Some((v >> 1) as i64 ^ -((v & 1) as i64))
     }
+    /// Draws `n` boolean elements from the budget.
+    fn spend_bools(&mut self, n: u64) -> Option<()> {
+        self.bools = self.bools.checked_sub(n)?;
+        Some(())
+    }
     fn skip(&mut self, ty: u8, depth: u32) -> Option<()> {
-        if depth > 32 {
+        if depth > MAX_DEPTH {
             return None;
         }
         match ty {
@@ -391,12 +449,15 @@ impl Thrift<'_> {
                     15 => self.varint()?,
                     n => u64::from(n),
                 };
-                for _ in 0..n {
-                    // A boolean in a list is one byte.
-                    if h & 0x0f <= 2 {
-                        self.byte()?;
-                    } else {
-                        self.skip(h & 0x0f, depth + 1)?;
+                let elem = h & 0x0f;
+                if elem <= 2 {
+                    // the crate checks the element type (0 is none) and reads no byte
+                    (elem != 0 || n == 0).then_some(())?;
+                    self.spend_bools(n)?;
+                } else {
+                    // each element takes a byte at least: the walk ends within the bytes
+                    for _ in 0..n {
+                        self.skip(elem, depth + 1)?;
                     }
                 }
             }
@@ -404,15 +465,27 @@ impl Thrift<'_> {
                 let n = self.varint()?;
                 if n > 0 {
                     let kv = self.byte()?;
-                    for _ in 0..n {
-                        self.skip(kv >> 4, depth + 1)?;
-                        self.skip(kv & 0x0f, depth + 1)?;
+                    let (k, v) = (kv >> 4, kv & 0x0f);
+                    if k == 0 || v == 0 {
+                        return None;
+                    }
+                    if k <= 2 && v <= 2 {
+                        self.spend_bools(n.checked_mul(2)?)?;
+                    } else {
+                        if k <= 2 || v <= 2 {
+                            self.spend_bools(n)?;
+                        }
+                        for _ in 0..n {
+                            self.skip(k, depth + 1)?;
+                            self.skip(v, depth + 1)?;
+                        }
                     }
                 }
             }
             12 => {
                 self.fields(depth + 1, |_, _, _| Some(false))?;
             }
+            13 => self.i = self.i.checked_add(16)?,
             _ => return None,
         }
         (self.i <= self.b.len()).then_some(())
