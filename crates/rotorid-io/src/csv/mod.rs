@@ -21,3 +21,22 @@ pub mod table;
 pub use error::{CsvError, WriteFailure};
 pub use response::{ResponseReader, ResponseRow, Speed, RESPONSE_HEADER};
 pub use table::read_csv_table;
+
+/// A reader giving at most `step` bytes per read (tests): lines end up split across the
+/// record reader's buffer fills, where the readers' one-pass parse must leave them to the
+/// general path.
+#[cfg(test)]
+pub(crate) struct Trickle<'a> {
+    pub text: &'a [u8],
+    pub step: usize,
+}
+
+#[cfg(test)]
+impl std::io::Read for Trickle<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.step.min(buf.len()).min(self.text.len());
+        buf[..n].copy_from_slice(&self.text[..n]);
+        self.text = &self.text[n..];
+        Ok(n)
+    }
+}

@@ -196,6 +196,33 @@ impl<R: Read> RecordReader<R> {
         }
     }
 
+    /// The next line parsed by `parse` straight out of the read buffer, without looking for
+    /// its end first: `parse` gets the unread bytes from the line's start (running on past
+    /// it) and returns its value and the length of the line it took. The line and its end
+    /// are consumed, and its number returned, only when the byte after that length is a
+    /// line end already read, the line is within the cap, and `parse` vouches that it holds
+    /// no `"` or line end; otherwise (a blank line first, a line not whole in the buffer,
+    /// `parse` declining) nothing is consumed and [`next_raw`](Self::next_raw) reads it.
+    #[inline]
+    pub fn try_line<T>(
+        &mut self,
+        parse: impl FnOnce(&[u8]) -> Option<(T, usize)>,
+    ) -> Option<(T, u64)> {
+        let rest = &self.buf[self.pos..self.end];
+        if matches!(rest.first(), None | Some(b'\n' | b'\r')) {
+            return None;
+        }
+        let (value, len) = parse(rest)?;
+        if len > self.cap || !matches!(rest.get(len), Some(b'\n' | b'\r')) {
+            return None;
+        }
+        let line = self.line;
+        self.after_cr = false;
+        self.pos += len;
+        self.line_end();
+        Some((value, line))
+    }
+
     /// Skip blank lines, then find the next record's extent: a plain line (consumed with
     /// its line end) or a line with a quote (left for [`Self::quoted_record`]).
     #[inline]

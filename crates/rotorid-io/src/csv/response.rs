@@ -35,7 +35,8 @@ use std::io::Read;
 use std::ops::Range;
 
 use super::columns::{
-    check_length, csv_reader, finite_field, next_raw, next_record, one_pass, CsvReader, Header,
+    check_length, csv_reader, finite_field, line_prefix, next_raw, next_record, one_pass,
+    CsvReader, Header,
 };
 use super::error::CsvError;
 use super::number::{format_f64, readable};
@@ -223,6 +224,21 @@ impl<R: Read> ResponseReader<R> {
     /// count, ...) is split and checked field by field, which gives the same values and
     /// names what is wrong.
     pub fn next_row(&mut self) -> Result<Option<ResponseRow>, CsvError> {
+        if self.fast {
+            let (roles, conv, has_phi) = (&self.roles, &self.conv, self.phi.is_some());
+            if let Some((row, line)) = self.csv.try_line(|rest| {
+                let mut v = [0.0_f64; 6];
+                let len = line_prefix(
+                    rest,
+                    roles.len(),
+                    |j| roles[j] != UNUSED,
+                    |j, raw| take_si(&mut v, roles, conv, j, raw),
+                )?;
+                Some((row_of(v, has_phi), len))
+            }) {
+                return Ok(Some(ResponseRow { line, ..row }));
+            }
+        }
         let Some(raw) = next_raw(&self.file, &mut self.csv)? else {
             return Ok(None);
         };
@@ -286,18 +302,38 @@ fn fast_row(
         text,
         roles.len(),
         |j| roles[j] != UNUSED,
-        |j, raw| {
-            let role = usize::from(roles[j]);
-            let si = conv.get(role)?.apply(raw);
-            if !(raw.is_finite() && si.is_finite()) {
-                return None;
-            }
-            v[role] = si;
-            Some(())
-        },
+        |j, raw| take_si(&mut v, roles, conv, j, raw),
     )?;
     Some(ResponseRow {
         line,
+        ..row_of(v, has_phi)
+    })
+}
+
+/// Column `j`'s value `raw` into `v`, in SI, by its role; `None` (the general path) when
+/// it is not finite in the file or in SI.
+#[inline]
+fn take_si(
+    v: &mut [f64; 6],
+    roles: &[u8],
+    conv: &[Conversion; 6],
+    j: usize,
+    raw: f64,
+) -> Option<()> {
+    let role = usize::from(roles[j]);
+    let si = conv.get(role)?.apply(raw);
+    if !(raw.is_finite() && si.is_finite()) {
+        return None;
+    }
+    v[role] = si;
+    Some(())
+}
+
+/// The row of the values `v` by role (line 0: the caller sets it).
+#[inline]
+fn row_of(v: [f64; 6], has_phi: bool) -> ResponseRow {
+    ResponseRow {
+        line: 0,
         t: v[0],
         x: v[1],
         z: v[2],
@@ -306,7 +342,7 @@ fn fast_row(
             phi_dot: v[4],
             phi_ddot: v[5],
         }),
-    })
+    }
 }
 
 /// `v` of column `col` in SI by `c`; a finite value that overflows (`1e308 rev`) is an
@@ -540,10 +576,12 @@ mod tests {
         assert!(err(&format!("{h}0.2,0,0,9\n")).starts_with("d.csv line 4: long row"));
     }
 
-    /// Every row of `text` with the one-pass parse on or off: the rows' bits, or the error.
-    fn read_both(text: &[u8]) -> [Result<Vec<[u64; 7]>, String>; 2] {
-        [true, false].map(|fast| {
-            let mut r = ResponseReader::new("d.csv", text).map_err(|e| e.to_string())?;
+    /// Every row of `text` with the one-pass parse on, off, and on with `text` coming
+    /// `step` bytes per read ([`super::super::Trickle`]): the rows' bits, or the error.
+    fn read_three(text: &[u8], step: usize) -> [Result<Vec<[u64; 7]>, String>; 3] {
+        [(true, usize::MAX), (false, usize::MAX), (true, step)].map(|(fast, step)| {
+            let input = super::super::Trickle { text, step };
+            let mut r = ResponseReader::new("d.csv", input).map_err(|e| e.to_string())?;
             r.fast = fast;
             let mut rows = Vec::new();
             while let Some(row) = r.next_row().map_err(|e| e.to_string())? {
@@ -626,6 +664,8 @@ mod tests {
                 ),
                 0..6,
             ),
+            ends in proptest::collection::vec(0u8..5, 1..4),
+            step in 1usize..40,
         ) {
             let cols = header.split(',').count();
             let mut text = format!("{header}\n");
@@ -633,10 +673,16 @@ mod tests {
                 // mostly the header's count of fields, sometimes one more or fewer
                 let n = match i % 4 { 1 => cols + 1, 3 => cols - 1, _ => cols }.min(row.len());
                 text.push_str(&row[..n].join(","));
-                text.push_str(if i % 2 == 0 { "\n" } else { "\r\n" });
+                // LF, CRLF, a lone CR, a blank line after, or no line end at the end
+                let last = i + 1 == rows.len();
+                text.push_str(match (ends[i % ends.len()], last) {
+                    (4, true) => "",
+                    (e, _) => ["\n", "\r\n", "\r", "\n\n", "\n"][usize::from(e)],
+                });
             }
-            let [fast, general] = read_both(text.as_bytes());
-            proptest::prop_assert_eq!(fast, general, "{}", text);
+            let [fast, general, trickled] = read_three(text.as_bytes(), step);
+            proptest::prop_assert_eq!(&fast, &general, "{}", text);
+            proptest::prop_assert_eq!(&trickled, &general, "{} bytes per read: {}", step, text);
         }
     }
 }

@@ -7,7 +7,7 @@
 use std::io::Read;
 
 use super::columns::{
-    check_length, csv_reader, next_raw, next_record, number_field, one_pass, Header,
+    check_length, csv_reader, line_prefix, next_raw, next_record, number_field, one_pass, Header,
 };
 use super::error::CsvError;
 use super::records::{split_line, RawRecord};
@@ -44,11 +44,35 @@ fn read<R: Read>(file: &str, input: R, fast: bool) -> Result<Table, CsvError> {
             }
         })
         .collect();
-    // A plain line is parsed in one pass into `row` (columns::one_pass: the same values as
-    // the general path); any other goes field by field, which names what is wrong.
+    // A plain line is parsed in one pass into `row` (columns::line_prefix, straight out of
+    // the read buffer: the same values as the general path); any other goes field by
+    // field, which names what is wrong.
     let mut row = vec![0.0; channels.len()];
     let mut fields = Vec::with_capacity(channels.len());
-    while let Some(raw) = next_raw(file, &mut csv)? {
+    loop {
+        if fast {
+            let taken = csv.try_line(|rest| {
+                let len = line_prefix(
+                    rest,
+                    row.len(),
+                    |_| true,
+                    |j, v| {
+                        row[j] = v;
+                        Some(())
+                    },
+                )?;
+                Some(((), len))
+            });
+            if taken.is_some() {
+                for (ch, &v) in channels.iter_mut().zip(&row) {
+                    ch.data.push(v);
+                }
+                continue;
+            }
+        }
+        let Some(raw) = next_raw(file, &mut csv)? else {
+            break;
+        };
         let rec = match raw {
             RawRecord::Line { text, line } => {
                 let parsed = fast
@@ -139,16 +163,24 @@ mod tests {
                 ),
                 0..6,
             ),
+            ends in proptest::collection::vec(0u8..5, 1..4),
+            step in 1usize..40,
         ) {
             let mut text = (0..cols).map(|c| format!("c{c}")).collect::<Vec<_>>().join(",");
             text.push('\n');
             for (i, row) in rows.iter().enumerate() {
                 let n = match i % 4 { 1 => cols + 1, 3 => cols - 1, _ => cols };
                 text.push_str(&row[..n].join(","));
-                text.push('\n');
+                // LF, CRLF, a lone CR, a blank line after, or no line end at the end
+                let last = i + 1 == rows.len();
+                text.push_str(match (ends[i % ends.len()], last) {
+                    (4, true) => "",
+                    (e, _) => ["\n", "\r\n", "\r", "\n\n", "\n"][usize::from(e)],
+                });
             }
-            let bits = |fast| {
-                read("t.csv", text.as_bytes(), fast)
+            let bits = |fast, step| {
+                let input = super::super::Trickle { text: text.as_bytes(), step };
+                read("t.csv", input, fast)
                     .map(|t| {
                         t.channels
                             .iter()
@@ -157,7 +189,9 @@ mod tests {
                     })
                     .map_err(|e| e.to_string())
             };
-            proptest::prop_assert_eq!(bits(true), bits(false), "{}", text);
+            let general = bits(false, usize::MAX);
+            proptest::prop_assert_eq!(&bits(true, usize::MAX), &general, "{}", text);
+            proptest::prop_assert_eq!(&bits(true, step), &general, "{} bytes per read: {}", step, text);
         }
     }
 }
