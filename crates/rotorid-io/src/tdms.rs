@@ -422,8 +422,9 @@ struct Raw<'a> {
 
 impl Raw<'_> {
     /// `n` values of `t` of `channel` at file offset `at`, one every `stride` bytes, read
-    /// from `src`; the values are numbers `first..first + n` of the chunk's channel (as an
-    /// [`ReadError::InexactInteger`] counts them). The caller keeps them within the raw data.
+    /// from `src`; the values are numbers `first..first + n` of the channel, counted from
+    /// its first value in the file over every segment and chunk (as an
+    /// [`ReadError::InexactInteger`] names them). The caller keeps them within the raw data.
     #[allow(clippy::too_many_arguments)]
     fn samples<S: Source + ?Sized>(
         &self,
@@ -526,7 +527,8 @@ fn raw_data<S: Source + ?Sized>(
                 while first < i.count {
                     let m = per.min(i.count - first);
                     let at = p + first * i.size;
-                    let v = r.samples(src, at, first, m, i.size, d, &ch)?;
+                    let index = objects[k].data.len() as u64;
+                    let v = r.samples(src, at, index, m, i.size, d, &ch)?;
                     objects[k].data.extend_from_slice(&v);
                     first += m;
                 }
@@ -585,7 +587,8 @@ fn interleaved_data<S: Source + ?Sized>(
                 if failed.as_ref().is_some_and(|(f, _)| *f <= j) {
                     break;
                 }
-                match r.samples(src, at + col, first, m, row, *d, ch) {
+                let index = objects[*k].data.len() as u64;
+                match r.samples(src, at + col, index, m, row, *d, ch) {
                     Ok(v) => objects[*k].data.extend_from_slice(&v),
                     Err(err @ ReadError::Io { .. }) => return Err(err),
                     Err(err) => failed = Some((j, err)),
@@ -666,7 +669,7 @@ mod tests {
     }
 
     #[test]
-    fn channels_longer_than_a_block_are_read_whole_and_errors_count_from_the_chunk() {
+    fn channels_longer_than_a_block_are_read_whole_and_errors_count_from_the_channel_start() {
         // two chunks of an f64 channel of 40 000 values and an i64 channel of 100 000
         let (na, nb) = (40_000u64, 100_000u64);
         let mut raw = Vec::new();
@@ -684,14 +687,15 @@ mod tests {
         let b: Vec<f64> = (0..2 * nb).map(|k| k as f64 - 7.0).collect();
         assert_eq!(t.channels[0].data, a);
         assert_eq!(t.channels[1].data, b);
-        // an i64 f64 cannot hold, 70 000 values into the second chunk's b
+        // an i64 f64 cannot hold, 70 000 values into the second chunk's b: value
+        // nb + 70 000 of channel b, as npTDMS's channel[i] numbers it
         let at = (2 * na + nb + 70_000) as usize * 8;
         raw[at..at + 8].copy_from_slice(&((1i64 << 60) + 1).to_le_bytes());
         let f = segment(0, &ch, &raw);
         let raw_start = (f.len() - raw.len()) as u64;
         match both(&f) {
             Err(ReadError::InexactInteger { index, offset, .. }) => {
-                assert_eq!(index, 70_000);
+                assert_eq!(index, (nb + 70_000) as usize);
                 assert_eq!(offset, raw_start + at as u64);
             }
             other => panic!("{other:?}"),
@@ -729,6 +733,21 @@ mod tests {
         match both(&f) {
             Err(ReadError::InexactInteger { channel, index, .. }) => {
                 assert_eq!((channel.as_str(), index), ("g/a", 95_000));
+            }
+            other => panic!("{other:?}"),
+        }
+        // two chunks of rows, b's value 20 000 of the second chunk bad: value n + 20 000 of
+        // channel b
+        let mut two = raw[..n as usize * 12].to_vec();
+        two.extend_from_slice(&raw[..n as usize * 12]);
+        let at = (n as usize + 20_000) * 12 + 4;
+        two[at..at + 8].copy_from_slice(&((1i64 << 60) + 1).to_le_bytes());
+        // (raw holds the bad b value 90 000 from above: made good again in the first chunk)
+        two[at_b..at_b + 8].copy_from_slice(&(90_000i64 - 5).to_le_bytes());
+        let f = segment(TOC_INTERLEAVED, &ch, &two);
+        match both(&f) {
+            Err(ReadError::InexactInteger { channel, index, .. }) => {
+                assert_eq!((channel.as_str(), index), ("g/b", n as usize + 20_000));
             }
             other => panic!("{other:?}"),
         }
