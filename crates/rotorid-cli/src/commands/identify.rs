@@ -7,10 +7,9 @@ mod args;
 mod report;
 mod stream;
 
-pub use args::IdentifyArgs;
+pub use args::{method_of, IdentifyArgs, IdentifyMethod, MethodOptions};
 
 use anyhow::Context as _;
-use args::method_of;
 
 use crate::io::tables;
 use crate::io::LoadScenario as _;
@@ -18,7 +17,13 @@ use crate::io::{check_distinct_files, is_broken_pipe, open_input, FileMode, Outp
 
 /// Run `rotorid identify`: scenario and options -> pipeline -> outputs.
 pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
-    let method = method_of(&args)?;
+    let method = method_of(args.method, &args.settings, args.every)?;
+    if !(args.time_tolerance.is_finite() && args.time_tolerance >= 0.0) {
+        anyhow::bail!(
+            "--time-tolerance = {} is out of range: must be finite and >= 0 (relative to dt)",
+            args.time_tolerance
+        );
+    }
     let mut outputs = vec![("--out", args.out.as_str())];
     if let Some(s) = &args.summary {
         outputs.push(("--summary", s.as_str()));

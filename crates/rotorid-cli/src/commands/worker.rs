@@ -4,16 +4,19 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use rotorid::pipeline::Method;
 use rotorid_fleet::drift::DriftSettings;
 use rotorid_fleet::nats::Fleet;
 use rotorid_fleet::worker::{run as run_worker, shutdown_signal, Scenarios, WorkerConfig};
 
+use crate::commands::identify::{method_of, IdentifyMethod, MethodOptions};
+
 /// Identify the windows on rotorid.raw.> (a durable pull consumer shared by all workers).
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Example:\n  rotorid worker --nats nats://127.0.0.1:4222 --scenarios \
-                        fleet/ --method modulating"
+    after_help = "Examples:\n  rotorid worker --nats nats://127.0.0.1:4222 --scenarios \
+                        fleet/ --method modulating\n  rotorid worker --nats \
+                        nats://127.0.0.1:4222 --scenario rig.toml --method refine \
+                        --unknowns m,kx,kz --window 0.05"
 )]
 pub struct WorkerArgs {
     /// The NATS server.
@@ -22,9 +25,12 @@ pub struct WorkerArgs {
     /// The durable consumer's name: workers with the same name share the windows.
     #[arg(long, value_name = "NAME", default_value = rotorid_fleet::DEFAULT_DURABLE)]
     pub durable: String,
-    /// The identification method (its default settings).
+    /// The identification method; its settings are the options below, as in `rotorid
+    /// identify` (the algebraic identifier's result is its last estimate).
     #[arg(long, value_enum, default_value = "modulating")]
-    pub method: MethodArg,
+    pub method: IdentifyMethod,
+    #[command(flatten)]
+    pub settings: MethodOptions,
     /// One scenario for every machine: `table1` or a TOML file.
     #[arg(
         long,
@@ -55,24 +61,9 @@ pub struct WorkerArgs {
     pub verbose: bool,
 }
 
-/// `--method`.
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum MethodArg {
-    /// Algebraic (on-line, per sample; the result is the last estimate).
-    Algebraic,
-    /// Modulating functions (batch least squares).
-    Modulating,
-    /// Output-error refinement (slowest, most accurate).
-    Refine,
-}
-
 /// Run `rotorid worker` until SIGINT or SIGTERM.
 pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
-    let method = match args.method {
-        MethodArg::Algebraic => Method::algebraic(),
-        MethodArg::Modulating => Method::modulating(),
-        MethodArg::Refine => Method::refine(),
-    };
+    let method = method_of(args.method, &args.settings, None)?;
     let scenarios = match (args.scenario, args.scenarios) {
         (Some(s), _) => Scenarios::One(s),
         (None, Some(d)) => Scenarios::Dir(d),

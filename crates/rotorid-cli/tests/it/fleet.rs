@@ -2,7 +2,8 @@
 //! nats-server (JetStream, its own store and port; `.ci/test` installs the Debian package):
 //! a recording published in windows is identified by a worker process, the status lists
 //! every window with estimates that agree with the truth, the same estimates offline
-//! `rotorid identify` gives on each window's samples, and SIGTERM stops the worker cleanly.
+//! `rotorid identify` gives on each window's samples with the same method settings, and
+//! SIGTERM stops the worker cleanly; the settings are checked before connecting.
 
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -74,6 +75,9 @@ fn a_recording_published_in_windows_is_identified_by_a_worker() {
             "table1",
             "--method",
             "refine",
+            // settings reach the worker: three unknowns, the others known from table1
+            "--unknowns",
+            "m,kx,kz",
         ])
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -125,6 +129,8 @@ fn a_recording_published_in_windows_is_identified_by_a_worker() {
         "table1",
         "--method",
         "refine",
+        "--unknowns",
+        "m,kx,kz",
         "--out",
         dir.path().join("e.csv").to_str().unwrap(),
         "--summary",
@@ -134,7 +140,7 @@ fn a_recording_published_in_windows_is_identified_by_a_worker() {
     let offline: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&sum).unwrap()).unwrap();
     let got = estimates(&status);
-    assert_eq!(got.len(), 5, "{status}");
+    assert_eq!(got.len(), 3, "m, kx, kz estimated; cx, cz known: {status}");
     for (name, v, e) in got {
         let p = offline["parameters"]
             .as_array()
@@ -182,4 +188,37 @@ fn publish_refuses_a_machine_id_that_is_not_a_subject_token() {
         err.contains("--machine \"rig 1.a\"") && err.contains("letters, digits"),
         "{err}"
     );
+}
+
+#[test]
+fn worker_settings_are_checked_against_the_method_before_connecting() {
+    for (args, want) in [
+        (
+            &["--method", "algebraic", "--window", "1"][..],
+            "--window applies to --method modulating and refine only, not to --method algebraic",
+        ),
+        (
+            &["--method", "modulating", "--restart", "0.5"][..],
+            "--restart applies to --method algebraic only, not to --method modulating",
+        ),
+        (
+            &["--method", "refine", "--rcond-min", "2"][..],
+            "--rcond-min = 2 is out of range: must be in [0, 1]",
+        ),
+    ] {
+        let out = rotorid()
+            .args([
+                "worker",
+                "--nats",
+                "nats://127.0.0.1:1",
+                "--scenario",
+                "table1",
+            ])
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(want), "{args:?}: {err}");
+    }
 }

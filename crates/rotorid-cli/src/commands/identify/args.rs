@@ -147,6 +147,40 @@ pub struct IdentifyArgs {
     #[arg(long, value_enum, default_value_t = IdentifyMethod::Algebraic)]
     pub method: IdentifyMethod,
 
+    /// algebraic only: write every N-th estimate (the 1st, (N+1)-th, ...); all are computed
+    /// and tracked [default: 1].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub every: Option<u64>,
+
+    #[command(flatten)]
+    pub settings: MethodOptions,
+
+    /// Allowed deviation of each time step from dt = t_2 - t_1, relative to dt.
+    #[arg(long, value_name = "REL", default_value = TIME_TOLERANCE_TEXT, allow_hyphen_values = true)]
+    pub time_tolerance: f64,
+
+    /// The estimates CSV, or `-` for stdout. Written as it goes (a file can be followed
+    /// while it grows); after an error it holds the whole rows written before it. A name
+    /// ending in `.parquet` writes the same columns as Parquet (a withheld estimate is a
+    /// null), whole at the end: nothing on error.
+    #[arg(long, short, value_name = "ESTIMATES.csv|ESTIMATES.parquet|-")]
+    pub out: String,
+
+    /// Also write a JSON summary: final values, identification times, truth and relative
+    /// errors, flagged counts; for modulating and refine also noise levels, standard
+    /// errors, Cramer-Rao bounds, warnings (see the documentation of the summary format).
+    #[arg(long, value_name = "SUMMARY.json")]
+    pub summary: Option<String>,
+
+    /// Do not print the summary on stderr (warnings are still printed).
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// The method's settings, shared by `rotorid identify` and `rotorid worker` (each checked
+/// against the method and its range by [`method_of`]).
+#[derive(Debug, Clone, clap::Args)]
+pub struct MethodOptions {
     /// refine only: the quantities to estimate, comma-separated, from m, cx, kx, cz, kz, a,
     /// unbalance (m_u d and alpha) [default: m,cx,kx,cz,kz]. The initial state is always
     /// estimated; the others are known (from the scenario).
@@ -158,11 +192,6 @@ pub struct IdentifyArgs {
         "(order 2, as the paper), am3, am4, am5 (Adams-Moulton, order 3-5) [default: ",
         quadrature_text!(), "]. algebraic, and refine's algebraic fallback start"))]
     pub quadrature: Option<Quadrature>,
-
-    /// algebraic only: write every N-th estimate (the 1st, (N+1)-th, ...); all are computed
-    /// and tracked [default: 1].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
-    pub every: Option<u64>,
 
     #[arg(long, value_name = "REL", allow_hyphen_values = true, help = concat!(
         "algebraic only: relative band defining the identification time: the earliest t ",
@@ -190,27 +219,6 @@ pub struct IdentifyArgs {
         "(windows overlap: the hop is a fixed fraction of it, reported as modulating.hop_s in the summary) [default: ", window_text!(),
         "]"))]
     pub window: Option<f64>,
-
-    /// Allowed deviation of each time step from dt = t_2 - t_1, relative to dt.
-    #[arg(long, value_name = "REL", default_value = TIME_TOLERANCE_TEXT, allow_hyphen_values = true)]
-    pub time_tolerance: f64,
-
-    /// The estimates CSV, or `-` for stdout. Written as it goes (a file can be followed
-    /// while it grows); after an error it holds the whole rows written before it. A name
-    /// ending in `.parquet` writes the same columns as Parquet (a withheld estimate is a
-    /// null), whole at the end: nothing on error.
-    #[arg(long, short, value_name = "ESTIMATES.csv|ESTIMATES.parquet|-")]
-    pub out: String,
-
-    /// Also write a JSON summary: final values, identification times, truth and relative
-    /// errors, flagged counts; for modulating and refine also noise levels, standard
-    /// errors, Cramer-Rao bounds, warnings (see the documentation of the summary format).
-    #[arg(long, value_name = "SUMMARY.json")]
-    pub summary: Option<String>,
-
-    /// Do not print the summary on stderr (warnings are still printed).
-    #[arg(long, short)]
-    pub quiet: bool,
 }
 
 /// `--method` values.
@@ -255,11 +263,14 @@ pub enum UnknownName {
     Unbalance,
 }
 
-/// The method and its settings from the options (each option checked against its method
-/// and its range).
-pub(super) fn method_of(args: &IdentifyArgs) -> anyhow::Result<Method> {
+/// The method and its settings from `--every` (identify only) and the options (each option
+/// checked against its method and its range).
+pub fn method_of(
+    method: IdentifyMethod,
+    args: &MethodOptions,
+    every: Option<u64>,
+) -> anyhow::Result<Method> {
     let ok = |v: f64| v.is_finite() && v >= 0.0;
-    let method = args.method;
     let only = |flag: &str, given: bool, allowed: &[IdentifyMethod]| -> anyhow::Result<()> {
         if given && !allowed.contains(&method) {
             let names: Vec<&str> = allowed.iter().map(|m| m.name()).collect();
@@ -272,7 +283,7 @@ pub(super) fn method_of(args: &IdentifyArgs) -> anyhow::Result<Method> {
         Ok(())
     };
     use IdentifyMethod::{Algebraic, Modulating, Refine};
-    only("--every", args.every.is_some(), &[Algebraic])?;
+    only("--every", every.is_some(), &[Algebraic])?;
     only("--tol", args.tol.is_some(), &[Algebraic])?;
     only("--restart", args.restart.is_some(), &[Algebraic])?;
     only(
@@ -316,12 +327,6 @@ pub(super) fn method_of(args: &IdentifyArgs) -> anyhow::Result<Method> {
         }
         algebraic.rcond_min = r;
         modulating.config.rcond_min = r;
-    }
-    if !ok(args.time_tolerance) {
-        anyhow::bail!(
-            "--time-tolerance = {} is out of range: must be finite and >= 0 (relative to dt)",
-            args.time_tolerance
-        );
     }
     Ok(match method {
         Algebraic => Method::Algebraic(algebraic),
