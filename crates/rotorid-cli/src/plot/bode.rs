@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
-use super::campbell::{with_std, CriticalMark};
+use super::campbell::{critical_legend, CriticalMark};
 use super::canvas::{band, de, font, polyline, text, Axes, Drawing};
 use super::ticks::TickFormat;
 use super::{rgb, Rgb};
@@ -372,42 +372,7 @@ impl BodePlot {
             )?;
         }
         y += 1.5 * row;
-        text(
-            side,
-            "Critical speeds:",
-            (x, y),
-            18 * k,
-            (HPos::Left, VPos::Center),
-        )?;
-        y += row;
-        if self.critical.is_empty() {
-            text(
-                side,
-                "none in range",
-                (x + 10.0 * kf, y),
-                18 * k,
-                (HPos::Left, VPos::Center),
-            )?;
-        }
-        for (n, c) in self.critical.iter().enumerate() {
-            let whirl = c.whirl.map_or("no whirl direction", |w| w.name());
-            text(
-                side,
-                &format!("{}: {}", n + 1, with_std(c.rpm, c.std_rpm, "rpm")),
-                (x + 10.0 * kf, y),
-                18 * k,
-                (HPos::Left, VPos::Center),
-            )?;
-            y += 0.8 * row;
-            text(
-                side,
-                &format!("    {whirl}"),
-                (x + 10.0 * kf, y),
-                18 * k,
-                (HPos::Left, VPos::Center),
-            )?;
-            y += row;
-        }
+        y = critical_legend(side, &self.critical, (x, y), k)?;
         y += 0.5 * row;
         for line in [
             "Phase lag: shaft angle from",

@@ -64,6 +64,46 @@ pub fn with_std(value: f64, std: Option<f64>, unit: &str) -> String {
     s.trim_end().to_string()
 }
 
+/// The side panel's list of critical speeds (`Critical speeds:`, then each with its
+/// standard deviation and whirl, or `none in range`) from `(x, y)` at scale `k`; returns
+/// the y below it. Shared by the Campbell diagram and the Bode plot.
+pub fn critical_legend<DB: DrawingBackend>(
+    side: &DrawingArea<DB, Shift>,
+    critical: &[CriticalMark],
+    (x, mut y): (f64, f64),
+    k: u32,
+) -> anyhow::Result<f64> {
+    let kf = k as f64;
+    let row = 30.0 * kf;
+    let left = (HPos::Left, VPos::Center);
+    text(side, "Critical speeds:", (x, y), 18 * k, left)?;
+    y += row;
+    if critical.is_empty() {
+        text(side, "none in range", (x + 10.0 * kf, y), 18 * k, left)?;
+        y += row;
+    }
+    for (n, c) in critical.iter().enumerate() {
+        let whirl = c.whirl.map_or("no whirl direction", |w| w.name());
+        text(
+            side,
+            &format!("{}: {}", n + 1, with_std(c.rpm, c.std_rpm, "rpm")),
+            (x + 10.0 * kf, y),
+            18 * k,
+            left,
+        )?;
+        y += 0.8 * row;
+        text(
+            side,
+            &format!("    {whirl}"),
+            (x + 10.0 * kf, y),
+            18 * k,
+            left,
+        )?;
+        y += row;
+    }
+    Ok(y)
+}
+
 fn whirl_marker(w: Option<Whirl>) -> Marker {
     match w {
         Some(Whirl::Forward) => Marker::Up,
@@ -322,43 +362,7 @@ impl CampbellPlot {
         )?;
         y += 1.5 * row;
 
-        text(
-            side,
-            "Critical speeds:",
-            (x, y),
-            18 * k,
-            (HPos::Left, VPos::Center),
-        )?;
-        y += row;
-        if self.critical.is_empty() {
-            text(
-                side,
-                "none in range",
-                (x + 10.0 * kf, y),
-                18 * k,
-                (HPos::Left, VPos::Center),
-            )?;
-            y += row;
-        }
-        for (n, c) in self.critical.iter().enumerate() {
-            let whirl = c.whirl.map_or("no whirl direction", |w| w.name());
-            text(
-                side,
-                &format!("{}: {}", n + 1, with_std(c.rpm, c.std_rpm, "rpm")),
-                (x + 10.0 * kf, y),
-                18 * k,
-                (HPos::Left, VPos::Center),
-            )?;
-            y += 0.8 * row;
-            text(
-                side,
-                &format!("    {whirl}"),
-                (x + 10.0 * kf, y),
-                18 * k,
-                (HPos::Left, VPos::Center),
-            )?;
-            y += row;
-        }
+        y = critical_legend(side, &self.critical, (x, y), k)?;
 
         // colour bar
         y += 0.5 * row;
