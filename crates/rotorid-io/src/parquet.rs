@@ -265,11 +265,18 @@ fn read_inner<R: ChunkReader + 'static>(
 }
 
 /// Walks the Thrift footer (FileMetaData) the way the `parquet` crate will, before it
-/// does: the crate steps over an unknown field's list, set or map of booleans without
-/// reading a byte per element, so a count of 2^31 there costs it 2^31 empty iterations
-/// (seconds, from a footer of a few hundred bytes). Here such counts together must stay
-/// within the footer's length, every other element costs a byte or more, and nesting stops
-/// at 80 levels, so the crate's own parse of an accepted footer is linear in its length.
+/// does, so that the crate's own parse of an accepted footer is linear in its length:
+/// - the crate steps over an unknown field's list, set or map of booleans without reading
+///   a byte per element, so a count of 2^31 there costs it 2^31 empty iterations (seconds,
+///   from a footer of a few hundred bytes). Here such counts together must stay within the
+///   footer's length; every other element costs a byte or more;
+/// - the crate reads a field it knows as the type parquet-format declares, whatever type
+///   the field header gives, and from there reads the following bytes as something else
+///   than their headers say (where such a count can hide). Here every known field of every
+///   structure the crate reads (`FILE_META_DATA` and below) must come with its declared
+///   type, and list elements too;
+/// - nesting stops at 80 levels.
+///
 /// A footer that does not end in `PAR1` is left to the crate's error.
 fn check_footer(file: &str, size: u64, chunk: &ChunkFn<'_>) -> Result<(), ReadError> {
     if size < 12 {
@@ -286,7 +293,7 @@ fn check_footer(file: &str, size: u64, chunk: &ChunkFn<'_>) -> Result<(), ReadEr
     let start = size - 8 - len;
     let bytes = chunk(start, len)?;
     let mut t = Thrift::new(&bytes);
-    if t.skip(12, 0).is_none() {
+    if t.typed(&Ty::Struct(FILE_META_DATA), 0).is_none() {
         return Err(ReadError::invalid(
             file,
             None,
@@ -294,9 +301,9 @@ fn check_footer(file: &str, size: u64, chunk: &ChunkFn<'_>) -> Result<(), ReadEr
             "Parquet footer".into(),
             "a malformed Thrift structure",
             format!(
-                "a Thrift compact FileMetaData within the footer's {len} bytes, nested at most \
-                 {MAX_DEPTH} deep, whose containers of booleans hold at most {len} elements \
-                 together"
+                "a Thrift compact FileMetaData within the footer's {len} bytes, its fields of \
+                 their declared types, nested at most {MAX_DEPTH} deep, its containers of \
+                 booleans holding at most {len} elements together"
             ),
         ));
     }
@@ -491,7 +498,8 @@ impl<'a> Thrift<'a> {
         (self.i <= self.b.len()).then_some(())
     }
     /// Reads a struct's fields, giving `f` the chance to read each (it returns whether it
-    /// did); the others are skipped.
+    /// did); the others are skipped. A field header whose type is 0 ends the struct, as in
+    /// the `parquet` crate (whatever its id delta).
     fn fields(
         &mut self,
         depth: u32,
@@ -500,10 +508,10 @@ impl<'a> Thrift<'a> {
         let mut id: i16 = 0;
         loop {
             let h = self.byte()?;
-            if h == 0 {
+            let ty = h & 0x0f;
+            if ty == 0 {
                 return Some(());
             }
-            let ty = h & 0x0f;
             id = match h >> 4 {
                 0 => i16::try_from(self.zigzag()?).ok()?,
                 d => id.checked_add(i16::from(d))?,
@@ -513,15 +521,73 @@ impl<'a> Thrift<'a> {
             }
         }
     }
+    /// A struct of `schema`: each field it names must come with the wire type it declares
+    /// (the `parquet` crate reads a known field as its declared type whatever the wire
+    /// says, so a mismatch would put the two walks out of step) and is walked as that type,
+    /// unless `take` reads it (returning true); any other field is skipped.
+    fn typed_struct(
+        &mut self,
+        schema: &[(i16, Ty)],
+        depth: u32,
+        mut take: impl FnMut(&mut Self, i16) -> Option<bool>,
+    ) -> Option<()> {
+        if depth > MAX_DEPTH {
+            return None;
+        }
+        self.fields(depth + 1, |t, id, wire| {
+            let Some((_, ty)) = schema.iter().find(|(i, _)| *i == id) else {
+                return Some(false);
+            };
+            ty.matches(wire).then_some(())?;
+            if !take(t, id)? {
+                t.typed(ty, depth + 1)?;
+            }
+            Some(true)
+        })
+    }
+    /// A value of type `ty` (its field header already read).
+    fn typed(&mut self, ty: &Ty, depth: u32) -> Option<()> {
+        match ty {
+            Ty::Bool => {}
+            Ty::I8 => {
+                self.byte()?;
+            }
+            Ty::I16 | Ty::I32 | Ty::I64 => {
+                self.varint()?;
+            }
+            Ty::Double => self.i = self.i.checked_add(8)?,
+            Ty::Binary => {
+                let n = usize::try_from(self.varint()?).ok()?;
+                self.i = self.i.checked_add(n)?;
+            }
+            Ty::List(elem) => {
+                let h = self.byte()?;
+                let n = match h >> 4 {
+                    15 => self.varint()?,
+                    n => u64::from(n),
+                };
+                // the crate reads an empty list from a 0 header; otherwise the element
+                // type must be the declared one (no declared list holds booleans)
+                if h != 0 {
+                    (h & 0x0f == elem.wire()).then_some(())?;
+                    for _ in 0..n {
+                        self.typed(elem, depth + 1)?;
+                    }
+                }
+            }
+            Ty::Struct(schema) => self.typed_struct(schema, depth, |_, _| Some(false))?,
+        }
+        (self.i <= self.b.len()).then_some(())
+    }
     /// A PageHeader's uncompressed and compressed sizes.
     fn page_header(&mut self) -> Option<(i64, i64)> {
         let (mut unc, mut comp) = (None, None);
-        self.fields(0, |t, id, ty| match (id, ty) {
-            (2, 5) => {
+        self.typed_struct(PAGE_HEADER, 0, |t, id| match id {
+            2 => {
                 unc = Some(t.zigzag()?);
                 Some(true)
             }
-            (3, 5) => {
+            3 => {
                 comp = Some(t.zigzag()?);
                 Some(true)
             }
@@ -530,3 +596,191 @@ impl<'a> Thrift<'a> {
         Some((unc?, comp?))
     }
 }
+
+/// A Thrift type of the Parquet footer and page headers, as the `parquet` crate reads it.
+#[derive(Debug)]
+enum Ty {
+    Bool,
+    I8,
+    I16,
+    I32,
+    I64,
+    Double,
+    Binary,
+    List(&'static Ty),
+    Struct(&'static [(i16, Ty)]),
+}
+
+impl Ty {
+    /// Its compact-protocol type as a list element.
+    fn wire(&self) -> u8 {
+        match self {
+            Ty::Bool => 1,
+            Ty::I8 => 3,
+            Ty::I16 => 4,
+            Ty::I32 => 5,
+            Ty::I64 => 6,
+            Ty::Double => 7,
+            Ty::Binary => 8,
+            Ty::List(_) => 9,
+            Ty::Struct(_) => 12,
+        }
+    }
+    /// Whether a field header's type `wire` is this type.
+    fn matches(&self, wire: u8) -> bool {
+        match self {
+            Ty::Bool => wire == 1 || wire == 2,
+            t => t.wire() == wire,
+        }
+    }
+}
+
+// The structures of parquet-format 2.x the `parquet` crate (59) reads by their declared
+// types (file/metadata/thrift/mod.rs, basic.rs there); the fields it skips (ColumnMetaData
+// 3 and 8, RowGroup 6, the encryption fields without its `encryption` feature) are left
+// out, so they are skipped here too.
+const EMPTY: &[(i16, Ty)] = &[];
+const STATISTICS: &[(i16, Ty)] = &[
+    (1, Ty::Binary),
+    (2, Ty::Binary),
+    (3, Ty::I64),
+    (4, Ty::I64),
+    (5, Ty::Binary),
+    (6, Ty::Binary),
+    (7, Ty::Bool),
+    (8, Ty::Bool),
+];
+const TIME_UNIT: &[(i16, Ty)] = &[
+    (1, Ty::Struct(EMPTY)),
+    (2, Ty::Struct(EMPTY)),
+    (3, Ty::Struct(EMPTY)),
+];
+const TIMESTAMP: &[(i16, Ty)] = &[(1, Ty::Bool), (2, Ty::Struct(TIME_UNIT))];
+const LOGICAL_TYPE: &[(i16, Ty)] = &[
+    (1, Ty::Struct(EMPTY)),
+    (2, Ty::Struct(EMPTY)),
+    (3, Ty::Struct(EMPTY)),
+    (4, Ty::Struct(EMPTY)),
+    (5, Ty::Struct(&[(1, Ty::I32), (2, Ty::I32)])),
+    (6, Ty::Struct(EMPTY)),
+    (7, Ty::Struct(TIMESTAMP)),
+    (8, Ty::Struct(TIMESTAMP)),
+    (10, Ty::Struct(&[(1, Ty::I8), (2, Ty::Bool)])),
+    (11, Ty::Struct(EMPTY)),
+    (12, Ty::Struct(EMPTY)),
+    (13, Ty::Struct(EMPTY)),
+    (14, Ty::Struct(EMPTY)),
+    (15, Ty::Struct(EMPTY)),
+    (16, Ty::Struct(&[(1, Ty::I8)])),
+    (17, Ty::Struct(&[(1, Ty::Binary)])),
+    (18, Ty::Struct(&[(1, Ty::Binary), (2, Ty::I32)])),
+];
+const SCHEMA_ELEMENT: &[(i16, Ty)] = &[
+    (1, Ty::I32),
+    (2, Ty::I32),
+    (3, Ty::I32),
+    (4, Ty::Binary),
+    (5, Ty::I32),
+    (6, Ty::I32),
+    (7, Ty::I32),
+    (8, Ty::I32),
+    (9, Ty::I32),
+    (10, Ty::Struct(LOGICAL_TYPE)),
+];
+const KEY_VALUE: &[(i16, Ty)] = &[(1, Ty::Binary), (2, Ty::Binary)];
+const BOUNDING_BOX: &[(i16, Ty)] = &[
+    (1, Ty::Double),
+    (2, Ty::Double),
+    (3, Ty::Double),
+    (4, Ty::Double),
+    (5, Ty::Double),
+    (6, Ty::Double),
+    (7, Ty::Double),
+    (8, Ty::Double),
+];
+const COLUMN_META_DATA: &[(i16, Ty)] = &[
+    (1, Ty::I32),
+    (2, Ty::List(&Ty::I32)),
+    (4, Ty::I32),
+    (5, Ty::I64),
+    (6, Ty::I64),
+    (7, Ty::I64),
+    (9, Ty::I64),
+    (10, Ty::I64),
+    (11, Ty::I64),
+    (12, Ty::Struct(STATISTICS)),
+    (
+        13,
+        Ty::List(&Ty::Struct(&[(1, Ty::I32), (2, Ty::I32), (3, Ty::I32)])),
+    ),
+    (14, Ty::I64),
+    (15, Ty::I32),
+    (
+        16,
+        Ty::Struct(&[
+            (1, Ty::I64),
+            (2, Ty::List(&Ty::I64)),
+            (3, Ty::List(&Ty::I64)),
+        ]),
+    ),
+    (
+        17,
+        Ty::Struct(&[(1, Ty::Struct(BOUNDING_BOX)), (2, Ty::List(&Ty::I32))]),
+    ),
+];
+const COLUMN_CHUNK: &[(i16, Ty)] = &[
+    (1, Ty::Binary),
+    (2, Ty::I64),
+    (3, Ty::Struct(COLUMN_META_DATA)),
+    (4, Ty::I64),
+    (5, Ty::I32),
+    (6, Ty::I64),
+    (7, Ty::I32),
+];
+const ROW_GROUP: &[(i16, Ty)] = &[
+    (1, Ty::List(&Ty::Struct(COLUMN_CHUNK))),
+    (2, Ty::I64),
+    (3, Ty::I64),
+    (
+        4,
+        Ty::List(&Ty::Struct(&[(1, Ty::I32), (2, Ty::Bool), (3, Ty::Bool)])),
+    ),
+    (5, Ty::I64),
+    (7, Ty::I16),
+];
+const FILE_META_DATA: &[(i16, Ty)] = &[
+    (1, Ty::I32),
+    (2, Ty::List(&Ty::Struct(SCHEMA_ELEMENT))),
+    (3, Ty::I64),
+    (4, Ty::List(&Ty::Struct(ROW_GROUP))),
+    (5, Ty::List(&Ty::Struct(KEY_VALUE))),
+    (6, Ty::Binary),
+    (7, Ty::List(&Ty::Struct(&[(1, Ty::Struct(EMPTY))]))),
+];
+const DATA_PAGE_HEADER: &[(i16, Ty)] = &[
+    (1, Ty::I32),
+    (2, Ty::I32),
+    (3, Ty::I32),
+    (4, Ty::I32),
+    (5, Ty::Struct(STATISTICS)),
+];
+const DATA_PAGE_HEADER_V2: &[(i16, Ty)] = &[
+    (1, Ty::I32),
+    (2, Ty::I32),
+    (3, Ty::I32),
+    (4, Ty::I32),
+    (5, Ty::I32),
+    (6, Ty::I32),
+    (7, Ty::Bool),
+    (8, Ty::Struct(STATISTICS)),
+];
+const PAGE_HEADER: &[(i16, Ty)] = &[
+    (1, Ty::I32),
+    (2, Ty::I32),
+    (3, Ty::I32),
+    (4, Ty::I32),
+    (5, Ty::Struct(DATA_PAGE_HEADER)),
+    (6, Ty::Struct(EMPTY)),
+    (7, Ty::Struct(&[(1, Ty::I32), (2, Ty::I32), (3, Ty::Bool)])),
+    (8, Ty::Struct(DATA_PAGE_HEADER_V2)),
+];
