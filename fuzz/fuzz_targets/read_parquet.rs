@@ -1,6 +1,8 @@
 //! The parquet reader of rotorid-io on arbitrary bytes: no panic, no hang, no allocation
 //! beyond -rss_limit_mb; every error names the input; every channel read has a name and,
 //! when it has a time axis, a positive finite increment.
+//! A panic inside the parquet crate is caught by the reader (rotorid_io's `guard`,
+//! as in every build) and must come out as such an error.
 
 #![no_main]
 

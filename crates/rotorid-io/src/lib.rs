@@ -41,6 +41,7 @@ pub mod csv;
 mod cursor;
 pub mod error;
 pub mod format;
+mod guard;
 pub mod mat;
 pub mod npy;
 pub mod npz;

@@ -47,8 +47,8 @@ pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError>
 
 /// `run`, with a panic of the third-party parser on a hostile file made an error.
 fn guarded(file: &str, run: impl FnOnce() -> Result<Table, ReadError>) -> Result<Table, ReadError> {
-    // A third-party parser: a panic on a hostile file becomes an error here.
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|_| {
+    // A third-party parser: a panic on a hostile file becomes an error here (crate::guard).
+    crate::guard::quietly(run).unwrap_or_else(|| {
         Err(ReadError::Container {
             file: file.to_string(),
             channel: None,

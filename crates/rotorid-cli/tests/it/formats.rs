@@ -474,3 +474,29 @@ fn circles(svg: &str) -> Vec<(f64, f64)> {
         .map(|el| (attr(el, "cx"), attr(el, "cy")))
         .collect()
 }
+
+#[test]
+fn a_panic_of_the_parquet_crate_is_an_error_without_a_panic_message() {
+    // Found by fuzzing read_parquet: a BYTE_STREAM_SPLIT page shorter than its value count,
+    // on which the parquet crate (59.3.2) indexes out of bounds. rotorid reports an error
+    // naming the file, exits 1, and prints no "panicked" line or backtrace.
+    let fixture = format!(
+        "{}/../rotorid-io/fixtures/panic_bss.parquet",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    for command in ["inspect", "identify"] {
+        let mut cmd = rotorid();
+        cmd.env("RUST_BACKTRACE", "1").args([command, &fixture]);
+        if command == "identify" {
+            cmd.args(["--scenario", "table1", "--out", "-"]);
+        }
+        let out = cmd.output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{command}: {stderr}");
+        assert!(
+            stderr.contains("panic_bss.parquet: Parquet: the parquet reader failed"),
+            "{command}: {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{command}: {stderr}");
+    }
+}

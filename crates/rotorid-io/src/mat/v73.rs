@@ -102,8 +102,8 @@ fn read_hdf5(
         })
     };
     // The HDF5 layer is a third-party parser of a large format: a panic there on a hostile
-    // file becomes an error here rather than taking the caller down.
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|_| {
+    // file becomes an error here rather than taking the caller down (crate::guard).
+    crate::guard::quietly(run).unwrap_or_else(|| {
         Err(ReadError::Container {
             file: file.to_string(),
             channel: None,
