@@ -430,6 +430,22 @@ impl<'a> Thrift<'a> {
         let v = self.varint()?;
         Some((v >> 1) as i64 ^ -((v & 1) as i64))
     }
+    /// A list or set header: its first byte (the element type in the low nibble) and the
+    /// element count.
+    fn list_header(&mut self) -> Option<(u8, u64)> {
+        let h = self.byte()?;
+        let n = match h >> 4 {
+            15 => self.varint()?,
+            n => u64::from(n),
+        };
+        Some((h, n))
+    }
+    /// Steps over a binary (its length, then its bytes).
+    fn binary(&mut self) -> Option<()> {
+        let n = usize::try_from(self.varint()?).ok()?;
+        self.i = self.i.checked_add(n)?;
+        Some(())
+    }
     /// Draws `n` boolean elements from the budget.
     fn spend_bools(&mut self, n: u64) -> Option<()> {
         self.bools = self.bools.checked_sub(n)?;
@@ -446,16 +462,9 @@ impl<'a> Thrift<'a> {
                 self.varint()?;
             }
             7 => self.i = self.i.checked_add(8)?,
-            8 => {
-                let n = usize::try_from(self.varint()?).ok()?;
-                self.i = self.i.checked_add(n)?;
-            }
+            8 => self.binary()?,
             9 | 10 => {
-                let h = self.byte()?;
-                let n = match h >> 4 {
-                    15 => self.varint()?,
-                    n => u64::from(n),
-                };
+                let (h, n) = self.list_header()?;
                 let elem = h & 0x0f;
                 if elem <= 2 {
                     // the crate checks the element type (0 is none) and reads no byte
@@ -556,16 +565,9 @@ impl<'a> Thrift<'a> {
                 self.varint()?;
             }
             Ty::Double => self.i = self.i.checked_add(8)?,
-            Ty::Binary => {
-                let n = usize::try_from(self.varint()?).ok()?;
-                self.i = self.i.checked_add(n)?;
-            }
+            Ty::Binary => self.binary()?,
             Ty::List(elem) => {
-                let h = self.byte()?;
-                let n = match h >> 4 {
-                    15 => self.varint()?,
-                    n => u64::from(n),
-                };
+                let (h, n) = self.list_header()?;
                 // the crate reads an empty list from a 0 header; otherwise the element
                 // type must be the declared one (no declared list holds booleans)
                 if h != 0 {

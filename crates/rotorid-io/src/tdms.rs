@@ -64,6 +64,13 @@ struct Object {
     data: Vec<f64>,
 }
 
+impl Object {
+    /// `group/channel`, as messages name the object.
+    fn name(&self) -> String {
+        self.path.join("/")
+    }
+}
+
 /// Reads a TDMS file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
     read_from(file, bytes)
@@ -176,7 +183,7 @@ fn read_from<S: Source + ?Sized>(file: &str, src: &S) -> Result<Table, ReadError
         if o.path.len() != 2 || !o.numeric {
             continue;
         }
-        let name = format!("{}/{}", o.path[0], o.path[1]);
+        let name = o.name();
         let axis = match o.increment {
             None => None,
             Some(inc) if inc > 0.0 && inc.is_finite() => Some(TimeAxis {
@@ -504,7 +511,6 @@ fn raw_data<S: Source + ?Sized>(
         ));
     }
     let chunks = region / chunk;
-    let name = |objects: &[Object], k: usize| objects[k].path.join("/");
     if interleaved {
         return interleaved_data(src, r, &c, &present, chunk, chunks, objects);
     }
@@ -517,18 +523,18 @@ fn raw_data<S: Source + ?Sized>(
                 .reserve(i.count.saturating_mul(chunks) as usize);
         }
     }
+    let names: Vec<String> = present.iter().map(|&(k, _)| objects[k].name()).collect();
     for n in 0..chunks {
         let mut p = r.start + n * chunk;
-        for &(k, i) in &present {
+        for (&(k, i), ch) in present.iter().zip(&names) {
             if let Some(d) = i.dtype {
-                let ch = name(objects, k);
                 let per = (BLOCK / i.size).max(1);
                 let mut first = 0;
                 while first < i.count {
                     let m = per.min(i.count - first);
                     let at = p + first * i.size;
                     let index = objects[k].data.len() as u64;
-                    let v = r.samples(src, at, index, m, i.size, d, &ch)?;
+                    let v = r.samples(src, at, index, m, i.size, d, ch)?;
                     objects[k].data.extend_from_slice(&v);
                     first += m;
                 }
@@ -562,7 +568,7 @@ fn interleaved_data<S: Source + ?Sized>(
     let mut col = 0;
     for &(k, i) in &present[..bad.unwrap_or(present.len())] {
         if let Some(d) = i.dtype {
-            cols.push((k, col, d, objects[k].path.join("/")));
+            cols.push((k, col, d, objects[k].name()));
         }
         col += i.size;
     }
@@ -606,7 +612,7 @@ fn interleaved_data<S: Source + ?Sized>(
             "TDMS interleaved raw data",
             format!(
                 "{} with {} values of {} bytes",
-                objects[k].path.join("/"),
+                objects[k].name(),
                 i.count,
                 i.size
             ),

@@ -137,14 +137,7 @@ impl<'a, R: BufRead> Lines<'a, R> {
         let channel = self.channel.clone().unwrap_or_default();
         let nbytes = npts.saturating_mul(size);
         if nbytes > self.remaining() {
-            return Err(ReadError::Truncated {
-                file: self.file.to_string(),
-                channel: Some(channel),
-                offset: self.offset(),
-                what: format!("{npts} samples of {t:?}"),
-                need: nbytes,
-                available: self.remaining(),
-            });
+            return Err(self.truncated(&format!("{npts} samples of {t:?}"), nbytes));
         }
         let mut out = Vec::with_capacity(npts as usize);
         let mut block = Vec::new();
@@ -204,6 +197,7 @@ impl<'a, R: BufRead> Lines<'a, R> {
         }
     }
 }
+
 /// Reads the datasets of `input`, a UFF file of `size` bytes.
 fn read_from<R: BufRead>(file: &str, input: R, size: u64) -> Result<Table, ReadError> {
     let mut c = Lines {

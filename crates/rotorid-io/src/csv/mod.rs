@@ -40,3 +40,13 @@ impl std::io::Read for Trickle<'_> {
         Ok(n)
     }
 }
+
+/// The line end the readers' property tests put after a row (tests): by `code` (0 to 4) LF,
+/// CRLF, a lone CR, LF and a blank line, or LF; code 4 on the `last` row is no line end.
+#[cfg(test)]
+pub(crate) fn test_line_end(code: u8, last: bool) -> &'static str {
+    match (code, last) {
+        (4, true) => "",
+        (e, _) => ["\n", "\r\n", "\r", "\n\n", "\n"][usize::from(e)],
+    }
+}

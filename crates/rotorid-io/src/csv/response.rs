@@ -219,10 +219,11 @@ impl<R: Read> ResponseReader<R> {
 
     /// The next validated row, or `None` at the end of the input.
     ///
-    /// A line without quotes is first parsed in one pass (`columns::one_pass`); a line that pass
-    /// does not take (blanks around a field, a bad or non-finite number, a wrong field
-    /// count, ...) is split and checked field by field, which gives the same values and
-    /// names what is wrong.
+    /// A line without quotes is first parsed in one pass straight out of the read buffer
+    /// (`RecordReader::try_line` with `columns::line_prefix`), or, when it is not whole in
+    /// the buffer, once found (`columns::one_pass`); a line that pass does not take (blanks
+    /// around a field, a bad or non-finite number, a wrong field count, ...) is split and
+    /// checked field by field, which gives the same values and names what is wrong.
     pub fn next_row(&mut self) -> Result<Option<ResponseRow>, CsvError> {
         if self.fast {
             let (roles, conv, has_phi) = (&self.roles, &self.conv, self.phi.is_some());
@@ -675,10 +676,7 @@ mod tests {
                 text.push_str(&row[..n].join(","));
                 // LF, CRLF, a lone CR, a blank line after, or no line end at the end
                 let last = i + 1 == rows.len();
-                text.push_str(match (ends[i % ends.len()], last) {
-                    (4, true) => "",
-                    (e, _) => ["\n", "\r\n", "\r", "\n\n", "\n"][usize::from(e)],
-                });
+                text.push_str(super::super::test_line_end(ends[i % ends.len()], last));
             }
             let [fast, general, trickled] = read_three(text.as_bytes(), step);
             proptest::prop_assert_eq!(&fast, &general, "{}", text);

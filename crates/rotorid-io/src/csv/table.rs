@@ -173,10 +173,7 @@ mod tests {
                 text.push_str(&row[..n].join(","));
                 // LF, CRLF, a lone CR, a blank line after, or no line end at the end
                 let last = i + 1 == rows.len();
-                text.push_str(match (ends[i % ends.len()], last) {
-                    (4, true) => "",
-                    (e, _) => ["\n", "\r\n", "\r", "\n\n", "\n"][usize::from(e)],
-                });
+                text.push_str(super::super::test_line_end(ends[i % ends.len()], last));
             }
             let bits = |fast, step| {
                 let input = super::super::Trickle { text: text.as_bytes(), step };
