@@ -109,15 +109,19 @@ impl Drop for Worker {
     }
 }
 
-/// The test worker binary as a child process.
-pub fn spawn_worker(url: &str, durable: &str, method: &str, dir: &Path, ack_wait_s: f64) -> Worker {
-    let child = Command::new(env!("CARGO_BIN_EXE_rotorid-fleet-worker"))
-        .arg(url)
-        .arg(durable)
-        .arg(method)
+/// The command of the test worker binary, its stdout piped (for its closing line).
+fn worker_command(url: &str, durable: &str, method: &str, dir: &Path, ack_wait_s: f64) -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_rotorid-fleet-worker"));
+    cmd.args([url, durable, method])
         .arg(dir)
         .arg(ack_wait_s.to_string())
-        .stdout(Stdio::piped())
+        .stdout(Stdio::piped());
+    cmd
+}
+
+/// The test worker binary as a child process.
+pub fn spawn_worker(url: &str, durable: &str, method: &str, dir: &Path, ack_wait_s: f64) -> Worker {
+    let child = worker_command(url, durable, method, dir, ack_wait_s)
         .spawn()
         .expect("the worker starts");
     Worker(Some(child))
@@ -140,12 +144,8 @@ pub fn spawn_watched_worker(
     dir: &Path,
     ack_wait_s: f64,
 ) -> Watched {
-    let child = Command::new(env!("CARGO_BIN_EXE_rotorid-fleet-worker"))
-        .args([url, durable, method])
-        .arg(dir)
-        .arg(ack_wait_s.to_string())
+    let child = worker_command(url, durable, method, dir, ack_wait_s)
         .env("ROTORID_FLEET_VERBOSE", "1")
-        .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .expect("the worker starts");
