@@ -133,6 +133,16 @@ impl<'a> DiskFile<'a> {
         Ok(buf)
     }
 
+    /// The bytes `[at, at + len)` into `buf` (resized to `len`; its memory is reused, so a
+    /// caller reading piece after piece faults and zeroes it once).
+    pub fn read_at_into(&self, at: u64, len: u64, buf: &mut Vec<u8>) -> Result<(), ReadError> {
+        use std::os::unix::fs::FileExt as _;
+        buf.resize(len as usize, 0);
+        self.f
+            .read_exact_at(buf, at)
+            .map_err(|e| Self::io(self.file, e))
+    }
+
     /// A second handle on the file (for readers that take ownership).
     pub fn handle(&self) -> Result<std::fs::File, ReadError> {
         self.f.try_clone().map_err(|e| Self::io(self.file, e))

@@ -23,14 +23,51 @@ const MAX_DEFLATE_RATIO: u64 = 1032;
 
 /// Reads an `.npz` file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
-    read_from(file, std::io::Cursor::new(bytes), bytes.len() as u64)
+    read_from(
+        file,
+        std::io::Cursor::new(bytes),
+        bytes.len() as u64,
+        Direct::Bytes(bytes),
+    )
 }
 
 /// Reads the `.npz` file at `path` member by member: memory holds the channels and one
 /// member, never the whole file.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
     let disk = crate::format::DiskFile::open(file, path)?;
-    read_from(file, std::io::BufReader::new(disk.handle()?), disk.size)
+    read_from(
+        file,
+        std::io::BufReader::new(disk.handle()?),
+        disk.size,
+        Direct::Disk(&disk),
+    )
+}
+
+/// Where a stored member's bytes are taken from without the `zip` crate's reader (which
+/// copies them through its buffers and zeroes the destination first): the archive's bytes
+/// in memory (borrowed) or the file (read at the member's offset).
+enum Direct<'a, 'f> {
+    Bytes(&'a [u8]),
+    Disk(&'a crate::format::DiskFile<'f>),
+}
+
+impl Direct<'_, '_> {
+    /// The `len` bytes at `at`, which lie within the file (read into `scratch`, reused from
+    /// member to member, when they are on disk).
+    fn bytes<'s>(
+        &'s self,
+        at: u64,
+        len: u64,
+        scratch: &'s mut Vec<u8>,
+    ) -> Result<&'s [u8], ReadError> {
+        Ok(match self {
+            Direct::Bytes(b) => &b[at as usize..(at + len) as usize],
+            Direct::Disk(d) => {
+                d.read_at_into(at, len, scratch)?;
+                scratch
+            }
+        })
+    }
 }
 
 /// The table of the archive `input` of `size` bytes.
@@ -38,6 +75,7 @@ fn read_from<R: Read + std::io::Seek>(
     file: &str,
     input: R,
     size_of_file: u64,
+    direct: Direct,
 ) -> Result<Table, ReadError> {
     let zerr = |channel: Option<&str>, e: zip::result::ZipError| ReadError::Container {
         file: file.to_string(),
@@ -47,6 +85,7 @@ fn read_from<R: Read + std::io::Seek>(
     };
     let mut zip = zip::ZipArchive::new(input).map_err(|e| zerr(None, e))?;
     let mut channels = Vec::new();
+    let mut scratch = Vec::new();
     for i in 0..zip.len() {
         let mut member = zip.by_index(i).map_err(|e| zerr(None, e))?;
         let Some(name) = member.name().strip_suffix(".npy").map(str::to_string) else {
@@ -81,6 +120,29 @@ fn read_from<R: Read + std::io::Seek>(
                 found: format!("{size} bytes uncompressed from {packed} compressed"),
                 allowed: format!("at most {limit} (the file is {file_size} bytes)"),
             });
+        }
+        // A stored member lying within the file: its bytes as they are, checked against
+        // the member's CRC-32 as the zip crate's reader would.
+        let stored = (member.compression() == zip::CompressionMethod::Stored)
+            .then(|| member.data_start())
+            .flatten()
+            .filter(|&start| start.checked_add(size).is_some_and(|end| end <= file_size));
+        if let Some(start) = stored {
+            let bytes = direct.bytes(start, size, &mut scratch)?;
+            let crc = crc32fast::hash(bytes);
+            if crc != member.crc32() {
+                return Err(ReadError::Invalid {
+                    file: file.to_string(),
+                    channel: Some(name),
+                    offset: start,
+                    what: "zip member's CRC-32".into(),
+                    found: format!("{crc:#010x} over its {size} bytes"),
+                    allowed: format!("the declared {:#010x}", member.crc32()),
+                });
+            }
+            let mut c = Cursor::inflated(file, bytes, at);
+            channels.extend(npy::parse(&mut c, &name, true)?);
+            continue;
         }
         let mut buf = Vec::with_capacity(size as usize);
         (&mut member)

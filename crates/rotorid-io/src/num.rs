@@ -73,17 +73,35 @@ fn exact(v: i128, index: usize) -> Result<f64, Inexact> {
 
 macro_rules! gather {
     ($data:expr, $start:expr, $count:expr, $stride:expr, $n:literal, $e:expr, |$a:ident, $i:ident| $conv:expr) => {{
-        let mut out = Vec::with_capacity($count);
-        for $i in 0..$count {
-            let o = $start + $i * $stride;
-            let mut $a = [0u8; $n];
-            $a.copy_from_slice(&$data[o..o + $n]);
+        // The elements' bytes as one slice cut into strides: no bounds check per element,
+        // and contiguous little-endian data compiles to little more than a copy.
+        let convert = |$i: usize, bytes: &[u8]| {
+            let _ = $i;
+            let mut $a: [u8; $n] = bytes[..$n].try_into().expect("an element's bytes");
             if $e == Endian::Big {
                 $a.reverse();
             }
-            out.push($conv);
+            $conv
+        };
+        match $count {
+            0 => Vec::new(),
+            count if $stride == $n => $data[$start..$start + count * $n]
+                .chunks_exact($n)
+                .enumerate()
+                .map(|(i, b)| convert(i, b))
+                .collect(),
+            count if $stride > $n => $data[$start..$start + (count - 1) * $stride + $n]
+                .chunks($stride)
+                .enumerate()
+                .map(|(i, b)| convert(i, b))
+                .collect(),
+            count => (0..count)
+                .map(|i| {
+                    let o = $start + i * $stride;
+                    convert(i, &$data[o..o + $n])
+                })
+                .collect::<Vec<_>>(),
         }
-        out
     }};
 }
 

@@ -290,3 +290,30 @@ fn an_empty_npy_cannot_claim_endless_columns() {
     let t = read_bytes(Format::Npy, "three.npy", &b).unwrap();
     assert_eq!(t.channels.len(), 3);
 }
+
+/// A stored NPZ member is read without the zip crate's reader; its CRC-32 is still checked,
+/// from bytes and from disk alike, and the refusal names the member and the data's offset.
+#[test]
+fn a_stored_npz_member_that_fails_its_crc_is_refused() {
+    let good = fixture("rec.npz");
+    // x.npy's local header is at 2231; its data start after the 30-byte header, the name and
+    // the 20-byte zip64 extra field numpy writes
+    let mut bad = good.clone();
+    let data = 2231 + 30 + "x.npy".len() + 20;
+    let at = data + 200;
+    bad[at] ^= 0x40;
+    let path = std::env::temp_dir().join(format!("rotorid-crc-{}.npz", std::process::id()));
+    std::fs::write(&path, &bad).unwrap();
+    let from_disk = rotorid_io::read_table(&path);
+    std::fs::remove_file(&path).unwrap();
+    for e in [
+        read_bytes(Format::Npz, "bad.npz", &bad).unwrap_err(),
+        from_disk.unwrap_err(),
+    ] {
+        let msg = e.to_string();
+        assert!(msg.contains("CRC-32"), "{msg}");
+        assert!(msg.contains("channel \"x\""), "{msg}");
+        assert!(msg.contains(&format!("at byte {data} ")), "{msg}");
+    }
+    assert!(read_bytes(Format::Npz, "good.npz", &good).is_ok());
+}
