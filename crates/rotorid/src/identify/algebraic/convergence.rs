@@ -20,6 +20,12 @@
 //! above F + d (resp. below F - d) is found by scanning from the top; the answer is the
 //! instant right after it. O(1) amortised per estimate; the answer costs O(stack).
 //!
+//! The values reach the staircases in blocks of 64 per parameter: within a block, one
+//! backward scan keeps the values that exceed everything after them, the block's largest
+//! value pops what it would have popped, and the survivors are pushed. The staircases are
+//! bit for bit those of one-by-one pushes (when a stack could fill up during a block, its
+//! values go one by one), without a hard-to-predict pop loop per value.
+//!
 //! ## Bounded memory and its price
 //!
 //! A stack is capped (default [`DEFAULT_STACK_CAPACITY`] entries; a steadily drifting
@@ -102,12 +108,12 @@ impl Staircase {
         }
     }
 
+    /// Push one value. The top is always the entry pushed last (pops happen only here,
+    /// before the push), so its `t_next` is still unset.
     #[inline]
     fn push(&mut self, t: f64, v: f64) {
         if let Some(top) = self.steps.last_mut() {
-            if top.t_next.is_nan() {
-                top.t_next = t;
-            }
+            top.t_next = t;
         }
         while self.steps.last().is_some_and(|s| s.rep <= v) {
             self.steps.pop();
@@ -121,6 +127,55 @@ impl Staircase {
             rep: v,
             lo: v,
         });
+    }
+
+    /// Push the values `sign * v[i]` at times `t[i]` (at most [`BLOCK`]), with the same
+    /// result as pushing them one by one. Within the block, a value survives when it
+    /// exceeds every later one (one backward scan, whose branch is rarely taken, instead
+    /// of a pop loop per value whose exit is hard to predict); the block's largest value
+    /// pops what it would have popped, and the survivors are pushed in order. When the
+    /// stack could fill up during the block, the values go one by one, so that compaction
+    /// happens exactly when it would have.
+    fn push_block(&mut self, t: &[f64], v: &[f64], sign: f64) {
+        let n = t.len();
+        debug_assert!(n == v.len() && n <= BLOCK);
+        if n == 0 {
+            return;
+        }
+        if self.steps.len() + n >= self.cap {
+            for (&t, &v) in t.iter().zip(v) {
+                self.push(t, sign * v);
+            }
+            return;
+        }
+        // survivors, last first
+        let mut survivors = [0u8; BLOCK];
+        let mut k = 0;
+        let mut later_max = f64::NEG_INFINITY;
+        for i in (0..n).rev() {
+            let x = sign * v[i];
+            if x > later_max {
+                survivors[k] = i as u8;
+                k += 1;
+                later_max = x;
+            }
+        }
+        if let Some(top) = self.steps.last_mut() {
+            top.t_next = t[0];
+        }
+        while self.steps.last().is_some_and(|s| s.rep <= later_max) {
+            self.steps.pop();
+        }
+        self.steps.extend(survivors[..k].iter().rev().map(|&i| {
+            let i = usize::from(i);
+            let x = sign * v[i];
+            Step {
+                t: t[i],
+                t_next: t.get(i + 1).copied().unwrap_or(f64::NAN),
+                rep: x,
+                lo: x,
+            }
+        }));
     }
 
     /// Merge adjacent pairs whose merged range is at most the median range (each entry in
@@ -171,6 +226,9 @@ impl Staircase {
     }
 }
 
+/// Values a track holds back before it pushes them to its staircases together.
+const BLOCK: usize = 64;
+
 #[derive(Debug, Clone)]
 struct Track {
     /// Suffix maxima of v.
@@ -181,6 +239,11 @@ struct Track {
     last_t: f64,
     last_v: f64,
     count: u64,
+    /// Values not yet in the staircases: (t, v) of the last `held` well-conditioned
+    /// instants.
+    held_t: [f64; BLOCK],
+    held_v: [f64; BLOCK],
+    held: usize,
 }
 
 impl Track {
@@ -192,22 +255,49 @@ impl Track {
             last_t: f64::NAN,
             last_v: f64::NAN,
             count: 0,
+            held_t: [0.0; BLOCK],
+            held_v: [0.0; BLOCK],
+            held: 0,
         }
     }
 
+    /// Take (t, v) when `keep`, else nothing; written without a branch on `keep` (whether
+    /// an instant is well conditioned can change from sample to sample).
     #[inline]
-    fn push(&mut self, t: f64, v: f64) {
-        if self.count == 0 {
-            self.first_t = t;
+    fn push_if(&mut self, t: f64, v: f64, keep: bool) {
+        let first = keep && self.count == 0;
+        self.first_t = if first { t } else { self.first_t };
+        self.held_t[self.held] = t;
+        self.held_v[self.held] = v;
+        self.held += usize::from(keep);
+        self.last_t = if keep { t } else { self.last_t };
+        self.last_v = if keep { v } else { self.last_v };
+        self.count += u64::from(keep);
+        if self.held == BLOCK {
+            self.flush();
         }
-        self.max.push(t, v);
-        self.min.push(t, -v);
-        self.last_t = t;
-        self.last_v = v;
-        self.count += 1;
     }
 
+    /// The held values into the staircases.
+    fn flush(&mut self) {
+        let n = self.held;
+        self.max
+            .push_block(&self.held_t[..n], &self.held_v[..n], 1.0);
+        self.min
+            .push_block(&self.held_t[..n], &self.held_v[..n], -1.0);
+        self.held = 0;
+    }
+
+    /// This track with every value in its staircases.
+    fn flushed(&self) -> Self {
+        let mut t = self.clone();
+        t.flush();
+        t
+    }
+
+    /// The summary; the held values must have been flushed.
     fn result(&self, parameter: Parameter, tol: f64) -> ParameterConvergence {
+        debug_assert_eq!(self.held, 0);
         let resolution = self.max.resolution.max(self.min.resolution);
         if self.count == 0 {
             return ParameterConvergence {
@@ -309,9 +399,7 @@ impl ConvergenceTracker {
         let ok = e.well_conditioned(self.rcond_min);
         let v = e.values();
         for (i, track) in self.tracks.iter_mut().enumerate() {
-            if ok[i / 3] && v[i].is_finite() {
-                track.push(e.t, v[i]);
-            }
+            track.push_if(e.t, v[i], ok[i / 3] && v[i].is_finite());
         }
     }
 
@@ -320,7 +408,10 @@ impl ConvergenceTracker {
     pub fn stack_entries(&self) -> usize {
         self.tracks
             .iter()
-            .map(|t| t.max.steps.len() + t.min.steps.len())
+            .map(|t| {
+                let t = t.flushed();
+                t.max.steps.len() + t.min.steps.len()
+            })
             .sum()
     }
 
@@ -328,11 +419,71 @@ impl ConvergenceTracker {
     /// identifier does not estimate (m, a, mud, alpha).
     pub fn result(&self, p: Parameter) -> Option<ParameterConvergence> {
         let i = p.direction_index()?;
-        Some(self.tracks[i].result(p, self.tol))
+        Some(self.tracks[i].flushed().result(p, self.tol))
     }
 
     /// The summaries of all six, in [`Parameter::PER_DIRECTION`] order.
     pub fn results(&self) -> [ParameterConvergence; 6] {
-        std::array::from_fn(|i| self.tracks[i].result(Parameter::PER_DIRECTION[i], self.tol))
+        std::array::from_fn(|i| {
+            self.tracks[i]
+                .flushed()
+                .result(Parameter::PER_DIRECTION[i], self.tol)
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    fn same(a: &Staircase, b: &Staircase) -> bool {
+        let bits = |s: &Step| [s.t, s.t_next, s.rep, s.lo].map(f64::to_bits);
+        a.steps.len() == b.steps.len()
+            && a.steps
+                .iter()
+                .zip(&b.steps)
+                .all(|(x, y)| bits(x) == bits(y))
+            && a.resolution.to_bits() == b.resolution.to_bits()
+    }
+
+    /// Blocks give the staircases of one-by-one pushes bit for bit, whether or not the
+    /// stack fills and is compacted during the run: drifting, noisy and flat sequences,
+    /// capacities below, around and far above the block size, blocks cut short.
+    #[test]
+    fn blocks_are_one_by_one_pushes() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for case in 0..300 {
+            let cap = [2, 5, 63, 64, 65, 70, 130, 300, 4096][case % 9];
+            let n = rng.gen_range(1..3000);
+            let drift = [-1.0, 0.0, 1.0][case % 3] * 1e-3;
+            let noise = [0.0, 1e-4, 1.0][(case / 3) % 3];
+            let values: Vec<f64> = (0..n)
+                .map(|i| {
+                    let v: f64 = rng.gen_range(-1.0..1.0);
+                    // a few repeated values, so that ties are exercised
+                    let v = if rng.gen_range(0..8) == 0 { 0.5 } else { v };
+                    drift * i as f64 + noise * v
+                })
+                .collect();
+            let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-4).collect();
+            for sign in [1.0, -1.0] {
+                let mut one = Staircase::new(cap);
+                for (&t, &v) in t.iter().zip(&values) {
+                    one.push(t, sign * v);
+                }
+                let mut blocks = Staircase::new(cap);
+                let mut at = 0;
+                while at < n {
+                    let len = rng.gen_range(1..=BLOCK).min(n - at);
+                    blocks.push_block(&t[at..at + len], &values[at..at + len], sign);
+                    at += len;
+                }
+                assert!(
+                    same(&one, &blocks),
+                    "case {case}: cap {cap}, n {n}, sign {sign}"
+                );
+            }
+        }
     }
 }
