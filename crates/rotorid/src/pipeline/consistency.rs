@@ -43,7 +43,11 @@ impl SpeedConsistency {
         if let Some((p, w, a)) = self.last {
             let mut dphi = phi - p;
             let tau = std::f64::consts::TAU;
-            dphi -= tau * (dphi / tau).round();
+            let turns = dphi / tau;
+            // (round is a library call; within half a turn it gives 0 and changes nothing)
+            if turns.abs() >= 0.5 {
+                dphi -= tau * turns.round();
+            }
             let d = dphi / dt;
             let v = 0.5 * (omega + w);
             self.dv += d * v;

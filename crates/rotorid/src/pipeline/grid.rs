@@ -221,6 +221,32 @@ impl RunningGrid {
         })
     }
 
+    /// The same least-squares fit as [`fit`](Self::fit), written with two divisions
+    /// instead of four, for checking each stamp of a stream against as it arrives:
+    /// `dt = (n S_iu - S_i S_u) / (n^2 (n^2 - 1) / 12)` (the denominator is n S_ii - S_i^2
+    /// in closed form), `t0 = t_first + (S_u - dt S_i) / n`. It may differ from `fit`
+    /// in the last bits.
+    #[inline]
+    pub fn check_fit(&self) -> Option<TimeGrid> {
+        if self.n < 2 {
+            return None;
+        }
+        let n = self.n as f64;
+        let s_i = n * (n - 1.0) * 0.5;
+        let (s_u, s_iu) = (self.s_u.value(), self.s_iu.value());
+        let n2 = n * n;
+        let dt = (n * s_iu - s_i * s_u) / (n2 * (n2 - 1.0) * (1.0 / 12.0));
+        if !(dt.is_finite() && dt > 0.0) {
+            return None;
+        }
+        Some(TimeGrid {
+            t0: self.first + (s_u - dt * s_i) / n,
+            dt,
+            fitted_over: self.n,
+            max_deviation: 0.0,
+        })
+    }
+
     /// The fitted grid (snapped, module doc), `None` before two stamps; `max_deviation`
     /// is 0 (a stream cannot revisit its stamps).
     pub fn grid(&self) -> Option<TimeGrid> {
@@ -294,6 +320,28 @@ mod tests {
         assert!(g.max_deviation <= 0.6e-6, "{}", g.max_deviation);
         // the first two stamps would have said 3.9e-5 s, 0.16 % off
         assert!(((t[1] - t[0]) - dt).abs() > 1e-3 * dt);
+    }
+
+    /// The two-division fit a stream checks against is the fit, to rounding, from two
+    /// stamps to a million, with exact, jittered and offset stamps.
+    #[test]
+    fn the_check_fit_is_the_fit() {
+        for (t0, dt, jitter) in [
+            (0.0, 1e-4, 0.0),
+            (1.7e9, 3.90625e-5, 0.0),
+            (12.5, 2e-5, 0.3),
+        ] {
+            let mut g = RunningGrid::default();
+            for i in 0..1_000_000usize {
+                let wobble = jitter * dt * ((i as f64 * 0.37).sin());
+                g.push(i, t0 + i as f64 * dt + wobble).unwrap();
+                if i >= 1 && (i.is_power_of_two() || i % 99_991 == 0) {
+                    let (a, b) = (g.fit().unwrap(), g.check_fit().unwrap());
+                    assert!((a.dt - b.dt).abs() <= 1e-12 * a.dt, "{i}: {a:?} {b:?}");
+                    assert!((a.t0 - b.t0).abs() <= 1e-9 * a.dt, "{i}: {a:?} {b:?}");
+                }
+            }
+        }
     }
 
     #[test]

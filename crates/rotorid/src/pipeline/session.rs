@@ -265,6 +265,20 @@ impl Session {
     }
 
     fn validate(&mut self, index: usize, s: &Sample) -> Result<(), PipelineError> {
+        // v * 0 == 0 exactly when v is finite: one test for every field, the field named
+        // on the cold path
+        let speed_zero = s
+            .speed
+            .map_or(0.0, |v| v.phi * 0.0 + v.omega * 0.0 + v.omega_dot * 0.0);
+        if s.x * 0.0 + s.z * 0.0 + speed_zero != 0.0 {
+            return Err(Self::not_finite(index, s));
+        }
+        self.validate_presence_and_time(index, s)
+    }
+
+    /// The error naming the first non-finite field of `s`.
+    #[cold]
+    fn not_finite(index: usize, s: &Sample) -> PipelineError {
         let finite = |field: &'static str, value: f64| {
             if value.is_finite() {
                 Ok(())
@@ -276,13 +290,25 @@ impl Session {
                 })
             }
         };
-        finite("x", s.x)?;
-        finite("z", s.z)?;
-        if let Some(v) = s.speed {
-            finite("phi", v.phi)?;
-            finite("phi_dot", v.omega)?;
-            finite("phi_ddot", v.omega_dot)?;
-        }
+        let check = || {
+            finite("x", s.x)?;
+            finite("z", s.z)?;
+            if let Some(v) = s.speed {
+                finite("phi", v.phi)?;
+                finite("phi_dot", v.omega)?;
+                finite("phi_ddot", v.omega_dot)?;
+            }
+            Ok(())
+        };
+        // (only called when a field is not finite; x stands in otherwise)
+        check().err().unwrap_or(PipelineError::NotFinite {
+            index,
+            field: "x",
+            value: s.x,
+        })
+    }
+
+    fn validate_presence_and_time(&mut self, index: usize, s: &Sample) -> Result<(), PipelineError> {
         if *self.has_speed.get_or_insert(s.speed.is_some()) != s.speed.is_some() {
             return Err(PipelineError::SpeedPresence { index });
         }
@@ -304,7 +330,7 @@ impl Session {
                 // Check against the given grid, or the fit of every stamp so far.
                 let reference = match self.timing {
                     Timing::Grid { grid, .. } => Some(grid),
-                    Timing::Fit { .. } => self.running.fit(),
+                    Timing::Fit { .. } => self.running.check_fit(),
                 };
                 if let Some(g) = reference {
                     g.check(index, t, tolerance)?;
