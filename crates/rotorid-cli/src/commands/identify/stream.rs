@@ -63,8 +63,9 @@ struct Rows {
     writer: Option<EstimatesWriter<Output>>,
     /// For a Parquet output: the rows, written when the run ends (nothing on error).
     parquet: Option<Vec<EstimateRow>>,
-    /// Estimates seen (the `--every` counter).
-    seen: u64,
+    /// Estimates to skip before the next one written (the `--every` counter: a count down
+    /// rather than a remainder, which is a division per estimate).
+    skip: u64,
     every: u64,
     /// The first write error (a session's sink cannot return one).
     error: Option<io::Error>,
@@ -72,9 +73,12 @@ struct Rows {
 
 impl Rows {
     fn write(&mut self, e: &SampleEstimate) {
-        let n = self.seen;
-        self.seen += 1;
-        if !n.is_multiple_of(self.every) || self.error.is_some() {
+        if self.skip > 0 {
+            self.skip -= 1;
+            return;
+        }
+        self.skip = self.every.saturating_sub(1);
+        if self.error.is_some() {
             return;
         }
         if let Some(rows) = self.parquet.as_mut() {
@@ -182,7 +186,7 @@ pub(crate) fn identify(
             out,
             writer: None,
             parquet: io.parquet.then(Vec::new),
-            seen: 0,
+            skip: 0,
             every: io.every,
             error: None,
         },
