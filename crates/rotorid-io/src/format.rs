@@ -157,6 +157,14 @@ pub(crate) trait Source {
     fn size(&self) -> u64;
     /// The bytes `[at, at + len)` (the caller keeps them within the size).
     fn read_at(&self, at: u64, len: u64) -> Result<Cow<'_, [u8]>, ReadError>;
+    /// The same bytes, read into `scratch` when they must be read (its memory reused from
+    /// call to call by a caller reading block after block).
+    fn read_at_reusing<'s>(
+        &'s self,
+        at: u64,
+        len: u64,
+        scratch: &'s mut Vec<u8>,
+    ) -> Result<&'s [u8], ReadError>;
 }
 
 impl Source for [u8] {
@@ -167,6 +175,15 @@ impl Source for [u8] {
     fn read_at(&self, at: u64, len: u64) -> Result<Cow<'_, [u8]>, ReadError> {
         Ok(Cow::Borrowed(&self[at as usize..(at + len) as usize]))
     }
+
+    fn read_at_reusing<'s>(
+        &'s self,
+        at: u64,
+        len: u64,
+        _: &'s mut Vec<u8>,
+    ) -> Result<&'s [u8], ReadError> {
+        Ok(&self[at as usize..(at + len) as usize])
+    }
 }
 
 impl Source for DiskFile<'_> {
@@ -176,5 +193,15 @@ impl Source for DiskFile<'_> {
 
     fn read_at(&self, at: u64, len: u64) -> Result<Cow<'_, [u8]>, ReadError> {
         DiskFile::read_at(self, at, len).map(Cow::Owned)
+    }
+
+    fn read_at_reusing<'s>(
+        &'s self,
+        at: u64,
+        len: u64,
+        scratch: &'s mut Vec<u8>,
+    ) -> Result<&'s [u8], ReadError> {
+        self.read_at_into(at, len, scratch)?;
+        Ok(scratch)
     }
 }

@@ -72,11 +72,10 @@ fn exact(v: i128, index: usize) -> Result<f64, Inexact> {
 }
 
 macro_rules! gather {
-    ($data:expr, $start:expr, $count:expr, $stride:expr, $n:literal, $e:expr, |$a:ident, $i:ident| $conv:expr) => {{
+    ($data:expr, $start:expr, $count:expr, $stride:expr, $n:literal, $e:expr, $out:expr, |$a:ident| $conv:expr) => {{
         // The elements' bytes as one slice cut into strides: no bounds check per element,
         // and contiguous little-endian data compiles to little more than a copy.
-        let convert = |$i: usize, bytes: &[u8]| {
-            let _ = $i;
+        let convert = |bytes: &[u8]| {
             let mut $a: [u8; $n] = bytes[..$n].try_into().expect("an element's bytes");
             if $e == Endian::Big {
                 $a.reverse();
@@ -84,29 +83,29 @@ macro_rules! gather {
             $conv
         };
         match $count {
-            0 => Vec::new(),
-            count if $stride == $n => $data[$start..$start + count * $n]
-                .chunks_exact($n)
-                .enumerate()
-                .map(|(i, b)| convert(i, b))
-                .collect(),
-            count if $stride > $n => $data[$start..$start + (count - 1) * $stride + $n]
-                .chunks($stride)
-                .enumerate()
-                .map(|(i, b)| convert(i, b))
-                .collect(),
-            count => (0..count)
-                .map(|i| {
-                    let o = $start + i * $stride;
-                    convert(i, &$data[o..o + $n])
-                })
-                .collect::<Vec<_>>(),
+            0 => {}
+            count if $stride == $n => $out.extend(
+                $data[$start..$start + count * $n]
+                    .chunks_exact($n)
+                    .map(convert),
+            ),
+            count if $stride > $n => $out.extend(
+                $data[$start..$start + (count - 1) * $stride + $n]
+                    .chunks($stride)
+                    .map(convert),
+            ),
+            count => $out.extend((0..count).map(|i| {
+                let o = $start + i * $stride;
+                convert(&$data[o..o + $n])
+            })),
         }
     }};
 }
 
 /// Decodes `count` elements of type `t`, the first at `data[start]`, one every `stride`
-/// bytes. The caller has checked that they lie within `data`.
+/// bytes, onto the end of `out`. The caller has checked that they lie within `data`. A
+/// 64-bit integer `f64` cannot hold is named by its index among the `count` (what was
+/// decoded before it stays in `out`).
 fn gather(
     data: &[u8],
     start: usize,
@@ -114,73 +113,47 @@ fn gather(
     stride: usize,
     t: Dtype,
     e: Endian,
-) -> Result<Vec<f64>, Inexact> {
-    Ok(match t {
-        Dtype::I8 => gather!(data, start, count, stride, 1, e, |a, i| a[0] as i8 as f64),
-        Dtype::U8 => gather!(data, start, count, stride, 1, e, |a, i| a[0] as f64),
-        Dtype::I16 => gather!(
-            data,
-            start,
-            count,
-            stride,
-            2,
-            e,
-            |a, i| i16::from_le_bytes(a) as f64
-        ),
-        Dtype::U16 => gather!(
-            data,
-            start,
-            count,
-            stride,
-            2,
-            e,
-            |a, i| u16::from_le_bytes(a) as f64
-        ),
-        Dtype::I32 => gather!(
-            data,
-            start,
-            count,
-            stride,
-            4,
-            e,
-            |a, i| i32::from_le_bytes(a) as f64
-        ),
-        Dtype::U32 => gather!(
-            data,
-            start,
-            count,
-            stride,
-            4,
-            e,
-            |a, i| u32::from_le_bytes(a) as f64
-        ),
-        Dtype::F32 => gather!(
-            data,
-            start,
-            count,
-            stride,
-            4,
-            e,
-            |a, i| f32::from_le_bytes(a) as f64
-        ),
-        Dtype::F64 => gather!(data, start, count, stride, 8, e, |a, i| f64::from_le_bytes(
-            a
-        )),
-        Dtype::I64 => {
-            let v = gather!(data, start, count, stride, 8, e, |a, i| exact(
-                i64::from_le_bytes(a) as i128,
-                i
-            ));
-            v.into_iter().collect::<Result<_, _>>()?
+    out: &mut Vec<f64>,
+) -> Result<(), Inexact> {
+    out.reserve(count);
+    match t {
+        Dtype::I8 => gather!(data, start, count, stride, 1, e, out, |a| a[0] as i8 as f64),
+        Dtype::U8 => gather!(data, start, count, stride, 1, e, out, |a| a[0] as f64),
+        Dtype::I16 => gather!(data, start, count, stride, 2, e, out, |a| {
+            i16::from_le_bytes(a) as f64
+        }),
+        Dtype::U16 => gather!(data, start, count, stride, 2, e, out, |a| {
+            u16::from_le_bytes(a) as f64
+        }),
+        Dtype::I32 => gather!(data, start, count, stride, 4, e, out, |a| {
+            i32::from_le_bytes(a) as f64
+        }),
+        Dtype::U32 => gather!(data, start, count, stride, 4, e, out, |a| {
+            u32::from_le_bytes(a) as f64
+        }),
+        Dtype::F32 => gather!(data, start, count, stride, 4, e, out, |a| {
+            f32::from_le_bytes(a) as f64
+        }),
+        Dtype::F64 => gather!(data, start, count, stride, 8, e, out, |a| {
+            f64::from_le_bytes(a)
+        }),
+        Dtype::I64 | Dtype::U64 => {
+            let mut wide = Vec::with_capacity(count);
+            if t == Dtype::I64 {
+                gather!(data, start, count, stride, 8, e, wide, |a| {
+                    i64::from_le_bytes(a) as i128
+                });
+            } else {
+                gather!(data, start, count, stride, 8, e, wide, |a| {
+                    u64::from_le_bytes(a) as i128
+                });
+            }
+            for (index, v) in wide.into_iter().enumerate() {
+                out.push(exact(v, index)?);
+            }
         }
-        Dtype::U64 => {
-            let v = gather!(data, start, count, stride, 8, e, |a, i| exact(
-                u64::from_le_bytes(a) as i128,
-                i
-            ));
-            v.into_iter().collect::<Result<_, _>>()?
-        }
-    })
+    }
+    Ok(())
 }
 
 impl Cursor<'_> {
@@ -196,6 +169,24 @@ impl Cursor<'_> {
         e: Endian,
         channel: &str,
     ) -> Result<Vec<f64>, ReadError> {
+        let mut out = Vec::new();
+        self.samples_into(start, count, stride, t, e, channel, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`samples`](Self::samples) onto the end of `out` (on an error, what was decoded
+    /// before the failing element stays there).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn samples_into(
+        &self,
+        start: usize,
+        count: u64,
+        stride: u64,
+        t: Dtype,
+        e: Endian,
+        channel: &str,
+        out: &mut Vec<f64>,
+    ) -> Result<(), ReadError> {
         let size = t.size() as u64;
         let need = match count {
             0 => Some(0),
@@ -219,7 +210,7 @@ impl Cursor<'_> {
                 })
             }
         }
-        gather(self.data, start, count as usize, stride as usize, t, e).map_err(|x| {
+        gather(self.data, start, count as usize, stride as usize, t, e, out).map_err(|x| {
             ReadError::InexactInteger {
                 file: self.file.to_string(),
                 channel: channel.to_string(),

@@ -432,8 +432,9 @@ impl Raw<'_> {
     /// from `src`; the values are numbers `first..first + n` of the channel, counted from
     /// its first value in the file over every segment and chunk (as an
     /// [`ReadError::InexactInteger`] names them). The caller keeps them within the raw data.
+    /// The values go onto the end of `out`; a block read from disk goes through `scratch`.
     #[allow(clippy::too_many_arguments)]
-    fn samples<S: Source + ?Sized>(
+    fn samples_into<S: Source + ?Sized>(
         &self,
         src: &S,
         at: u64,
@@ -442,14 +443,16 @@ impl Raw<'_> {
         stride: u64,
         t: Dtype,
         channel: &str,
-    ) -> Result<Vec<f64>, ReadError> {
+        scratch: &mut Vec<u8>,
+        out: &mut Vec<f64>,
+    ) -> Result<(), ReadError> {
         let len = n.saturating_sub(1) * stride + t.size() as u64;
-        let buf = src.read_at(at, len)?;
+        let buf = src.read_at_reusing(at, len, scratch)?;
         let c = Cursor {
             base: at,
-            ..Cursor::new(self.file, &buf)
+            ..Cursor::new(self.file, buf)
         };
-        c.samples(0, n, stride, t, self.e, channel)
+        c.samples_into(0, n, stride, t, self.e, channel, out)
             .map_err(|err| match err {
                 ReadError::InexactInteger {
                     file,
@@ -524,6 +527,7 @@ fn raw_data<S: Source + ?Sized>(
         }
     }
     let names: Vec<String> = present.iter().map(|&(k, _)| objects[k].name()).collect();
+    let mut scratch = Vec::new();
     for n in 0..chunks {
         let mut p = r.start + n * chunk;
         for (&(k, i), ch) in present.iter().zip(&names) {
@@ -533,9 +537,9 @@ fn raw_data<S: Source + ?Sized>(
                 while first < i.count {
                     let m = per.min(i.count - first);
                     let at = p + first * i.size;
-                    let index = objects[k].data.len() as u64;
-                    let v = r.samples(src, at, index, m, i.size, d, ch)?;
-                    objects[k].data.extend_from_slice(&v);
+                    let data = &mut objects[k].data;
+                    let index = data.len() as u64;
+                    r.samples_into(src, at, index, m, i.size, d, ch, &mut scratch, data)?;
                     first += m;
                 }
             }
@@ -581,6 +585,7 @@ fn interleaved_data<S: Source + ?Sized>(
         }
     }
     let per = (BLOCK / row.max(1)).max(1);
+    let mut scratch = Vec::new();
     for n in 0..chunks {
         let base = r.start + n * chunk;
         // The first failing column of this chunk, and its error.
@@ -593,11 +598,16 @@ fn interleaved_data<S: Source + ?Sized>(
                 if failed.as_ref().is_some_and(|(f, _)| *f <= j) {
                     break;
                 }
-                let index = objects[*k].data.len() as u64;
-                match r.samples(src, at + col, index, m, row, *d, ch) {
-                    Ok(v) => objects[*k].data.extend_from_slice(&v),
+                let data = &mut objects[*k].data;
+                let index = data.len() as u64;
+                match r.samples_into(src, at + col, index, m, row, *d, ch, &mut scratch, data) {
+                    Ok(()) => {}
                     Err(err @ ReadError::Io { .. }) => return Err(err),
-                    Err(err) => failed = Some((j, err)),
+                    Err(err) => {
+                        // (keep the channel as it was before this block)
+                        data.truncate(index as usize);
+                        failed = Some((j, err));
+                    }
                 }
             }
             first += m;

@@ -151,7 +151,7 @@ impl<'a, R: BufRead> Lines<'a, R> {
                 base: self.pos,
                 ..Cursor::new(self.file, &block)
             };
-            out.extend_from_slice(&c.samples(0, m, size, t, e, &channel)?);
+            c.samples_into(0, m, size, t, e, &channel, &mut out)?;
             self.pos += m * size;
             done += m;
         }
