@@ -153,7 +153,9 @@ fn read_inner<R: ChunkReader + 'static>(
             continue;
         };
         let max_def = cd.max_def_level();
-        let mut data: Vec<f64> = Vec::new();
+        // The declared rows, but never more values than the file has bytes: a hostile
+        // footer cannot make this allocation larger than 8 bytes per byte of the file.
+        let mut data: Vec<f64> = Vec::with_capacity((rows as u64).min(size) as usize);
         for rg in 0..reader.num_row_groups() {
             let group = reader
                 .get_row_group(rg)
@@ -168,11 +170,10 @@ fn read_inner<R: ChunkReader + 'static>(
                 let def = (max_def > 0).then_some(&mut defs);
                 let n = match &mut col_reader {
                     ColumnReader::DoubleColumnReader(r) => {
-                        let mut v = Vec::new();
+                        // (the values are appended to `data`, decoded in place)
                         let (recs, _, _) = r
-                            .read_records(BATCH, def, None, &mut v)
+                            .read_records(BATCH, def, None, &mut data)
                             .map_err(|e| err(file, Some(&name), e))?;
-                        data.extend(v);
                         recs
                     }
                     ColumnReader::FloatColumnReader(r) => {
@@ -346,13 +347,27 @@ fn check_pages(
                 format!("one within the file's {size} bytes"),
             )
         })?;
-    // the chunk's bytes; positions below stay file offsets
-    let bytes = chunk(start, len)?;
     let mut pos = start;
     while pos < end {
-        let mut t = Thrift::new(&bytes);
-        t.i = (pos - start) as usize;
-        let (unc, comp) = t.page_header().ok_or_else(|| {
+        // The page header from the first HEADER_WINDOW bytes at `pos`, or from the rest of
+        // the chunk when it runs past them: a walk that succeeds on a prefix reads the same
+        // bytes in the whole, and the boolean budget is the chunk's length either way. The
+        // pages' contents are not read here (the parquet crate reads them once).
+        let rest = end - pos;
+        let mut header = None;
+        for n in [rest.min(HEADER_WINDOW), rest] {
+            let bytes = chunk(pos, n)?;
+            let mut t = Thrift {
+                b: &bytes,
+                i: 0,
+                bools: len,
+            };
+            header = t.page_header().map(|h| (h, t.i as u64));
+            if header.is_some() || n == rest {
+                break;
+            }
+        }
+        let ((unc, comp), header_len) = header.ok_or_else(|| {
             bad(
                 pos,
                 "a malformed page header".into(),
@@ -366,7 +381,7 @@ fn check_pages(
                 "non-negative sizes".into(),
             ));
         };
-        let data = start + t.i as u64;
+        let data = pos + header_len;
         if comp > end - data {
             return Err(bad(
                 pos,
@@ -386,6 +401,10 @@ fn check_pages(
     }
     Ok(())
 }
+
+/// Bytes read at a page's start to walk its header (a page header of a numeric column is
+/// tens of bytes; a longer one is walked in the rest of its chunk).
+const HEADER_WINDOW: u64 = 4096;
 
 /// Deepest nesting of Thrift structures and containers walked (the `parquet` crate's skip
 /// allows 64 below the field it skips).
@@ -786,3 +805,74 @@ const PAGE_HEADER: &[(i16, Ty)] = &[
     (7, Ty::Struct(&[(1, Ty::I32), (2, Ty::I32), (3, Ty::Bool)])),
     (8, Ty::Struct(DATA_PAGE_HEADER_V2)),
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::RefCell;
+
+    /// A compact-protocol page header: type DATA_PAGE, the two sizes, and (when `pad` > 0)
+    /// an unknown binary field 20 of `pad` bytes, which the walk steps over.
+    fn header(unc: u32, comp: u32, pad: usize) -> Vec<u8> {
+        let zz = |v: u32| {
+            let mut z = u64::from(v) << 1;
+            let mut out = Vec::new();
+            loop {
+                let b = (z & 0x7f) as u8;
+                z >>= 7;
+                if z == 0 {
+                    out.push(b);
+                    return out;
+                }
+                out.push(b | 0x80);
+            }
+        };
+        let mut h = vec![0x15, 0x00, 0x15];
+        h.extend(zz(unc));
+        h.push(0x15);
+        h.extend(zz(comp));
+        if pad > 0 {
+            // long-form field header: type binary (8), then the field id 20, zigzag-encoded
+            h.extend([0x08, 40]);
+            let mut n = pad as u64;
+            while n >= 0x80 {
+                h.push((n as u8 & 0x7f) | 0x80);
+                n >>= 7;
+            }
+            h.push(n as u8);
+            h.extend(std::iter::repeat_n(b'p', pad));
+        }
+        h.push(0x00);
+        h
+    }
+
+    /// Page headers are walked in a window at each page's start, and in the rest of the
+    /// chunk when one runs past it; what the pages hold is never read.
+    #[test]
+    fn long_page_headers_are_walked_past_the_window() {
+        let mut chunk = header(10, 10, 6000);
+        let second = chunk.len() + 10;
+        chunk.extend([7u8; 10]);
+        chunk.extend(header(20, 20, 0));
+        chunk.extend([9u8; 20]);
+        let reads = RefCell::new(Vec::new());
+        let bytes = chunk.clone();
+        let read = |at: u64, len: u64| {
+            reads.borrow_mut().push((at, len));
+            Ok(bytes[at as usize..(at + len) as usize].to_vec())
+        };
+        let size = chunk.len() as u64;
+        check_pages("f.parquet", size, &read, "x", 0, size as i64).unwrap();
+        let rest = size - second as u64;
+        assert_eq!(
+            *reads.borrow(),
+            vec![(0, HEADER_WINDOW), (0, size), (second as u64, rest)]
+        );
+
+        // the long header cut short: refused at its page, after the whole rest was tried
+        let cut = 5000;
+        let read = |at: u64, len: u64| Ok(chunk[at as usize..(at + len) as usize].to_vec());
+        let e = check_pages("f.parquet", cut, &read, "x", 0, cut as i64).unwrap_err();
+        assert!(e.to_string().contains("malformed page header"), "{e}");
+    }
+}
