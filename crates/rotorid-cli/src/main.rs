@@ -23,8 +23,12 @@ macro_rules! out {
     }};
 }
 
+mod alloc;
 mod commands;
 mod io;
+
+#[global_allocator]
+static ALLOCATOR: alloc::HugePageAdvice = alloc::HugePageAdvice;
 mod plot;
 mod report;
 
