@@ -15,6 +15,7 @@ use std::io::Read;
 
 use crate::cursor::Cursor;
 use crate::error::ReadError;
+use crate::format::Source;
 use crate::npy;
 use crate::table::Table;
 
@@ -23,12 +24,7 @@ const MAX_DEFLATE_RATIO: u64 = 1032;
 
 /// Reads an `.npz` file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
-    read_from(
-        file,
-        std::io::Cursor::new(bytes),
-        bytes.len() as u64,
-        Direct::Bytes(bytes),
-    )
+    read_from(file, std::io::Cursor::new(bytes), bytes.len() as u64, bytes)
 }
 
 /// Reads the `.npz` file at `path` member by member: memory holds the channels and one
@@ -39,43 +35,17 @@ pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError>
         file,
         std::io::BufReader::new(disk.handle()?),
         disk.size,
-        Direct::Disk(&disk),
+        &disk,
     )
 }
 
-/// Where a stored member's bytes are taken from without the `zip` crate's reader (which
-/// copies them through its buffers and zeroes the destination first): the archive's bytes
-/// in memory (borrowed) or the file (read at the member's offset).
-enum Direct<'a, 'f> {
-    Bytes(&'a [u8]),
-    Disk(&'a crate::format::DiskFile<'f>),
-}
-
-impl Direct<'_, '_> {
-    /// The `len` bytes at `at`, which lie within the file (read into `scratch`, reused from
-    /// member to member, when they are on disk).
-    fn bytes<'s>(
-        &'s self,
-        at: u64,
-        len: u64,
-        scratch: &'s mut Vec<u8>,
-    ) -> Result<&'s [u8], ReadError> {
-        Ok(match self {
-            Direct::Bytes(b) => &b[at as usize..(at + len) as usize],
-            Direct::Disk(d) => {
-                d.read_at_into(at, len, scratch)?;
-                scratch
-            }
-        })
-    }
-}
-
-/// The table of the archive `input` of `size` bytes.
-fn read_from<R: Read + std::io::Seek>(
+/// The table of the archive `input` of `size` bytes; a stored member's bytes are read from
+/// `direct` (the same archive, in memory or on disk).
+fn read_from<R: Read + std::io::Seek, S: Source + ?Sized>(
     file: &str,
     input: R,
     size_of_file: u64,
-    direct: Direct,
+    direct: &S,
 ) -> Result<Table, ReadError> {
     let zerr = |channel: Option<&str>, e: zip::result::ZipError| ReadError::Container {
         file: file.to_string(),
@@ -128,7 +98,9 @@ fn read_from<R: Read + std::io::Seek>(
             .flatten()
             .filter(|&start| start.checked_add(size).is_some_and(|end| end <= file_size));
         if let Some(start) = stored {
-            let bytes = direct.bytes(start, size, &mut scratch)?;
+            // (read without the zip crate's reader, which zeroes the destination and copies
+            // the bytes through its buffers)
+            let bytes = direct.read_at_reusing(start, size, &mut scratch)?;
             let crc = crc32fast::hash(bytes);
             if crc != member.crc32() {
                 return Err(ReadError::Invalid {

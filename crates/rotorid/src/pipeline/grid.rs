@@ -210,11 +210,18 @@ impl RunningGrid {
         let (s_u, s_iu) = (self.s_u.value(), self.s_iu.value());
         // centred: sum (i - mean i)(u_i - mean u) / sum (i - mean i)^2
         let dt = (s_iu - s_i * s_u / n) / (s_ii - s_i * s_i / n);
+        self.grid_with(dt, s_i, s_u)
+    }
+
+    /// The grid of slope `dt` through the stamps' centroid, `None` unless `dt` is finite
+    /// and > 0.
+    #[inline]
+    fn grid_with(&self, dt: f64, s_i: f64, s_u: f64) -> Option<TimeGrid> {
         if !(dt.is_finite() && dt > 0.0) {
             return None;
         }
         Some(TimeGrid {
-            t0: self.first + (s_u - dt * s_i) / n,
+            t0: self.first + (s_u - dt * s_i) / self.n as f64,
             dt,
             fitted_over: self.n,
             max_deviation: 0.0,
@@ -236,15 +243,7 @@ impl RunningGrid {
         let (s_u, s_iu) = (self.s_u.value(), self.s_iu.value());
         let n2 = n * n;
         let dt = (n * s_iu - s_i * s_u) / (n2 * (n2 - 1.0) * (1.0 / 12.0));
-        if !(dt.is_finite() && dt > 0.0) {
-            return None;
-        }
-        Some(TimeGrid {
-            t0: self.first + (s_u - dt * s_i) / n,
-            dt,
-            fitted_over: self.n,
-            max_deviation: 0.0,
-        })
+        self.grid_with(dt, s_i, s_u)
     }
 
     /// The fitted grid (snapped, module doc), `None` before two stamps; `max_deviation`

@@ -308,7 +308,11 @@ impl Session {
         })
     }
 
-    fn validate_presence_and_time(&mut self, index: usize, s: &Sample) -> Result<(), PipelineError> {
+    fn validate_presence_and_time(
+        &mut self,
+        index: usize,
+        s: &Sample,
+    ) -> Result<(), PipelineError> {
         if *self.has_speed.get_or_insert(s.speed.is_some()) != s.speed.is_some() {
             return Err(PipelineError::SpeedPresence { index });
         }
