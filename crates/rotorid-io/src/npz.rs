@@ -91,9 +91,10 @@ fn read_from<R: Read + std::io::Seek, S: Source + ?Sized>(
                 allowed: format!("at most {limit} (the file is {file_size} bytes)"),
             });
         }
-        // A stored member lying within the file: its bytes as they are, checked against
-        // the member's CRC-32 as the zip crate's reader would.
-        let stored = (member.compression() == zip::CompressionMethod::Stored)
+        // A stored member lying within the file, as long as its two sizes agree: its bytes
+        // as they are, checked against the member's CRC-32 as the zip crate's reader would
+        // (sizes that disagree go the zip crate's way below, which refuses them).
+        let stored = (member.compression() == zip::CompressionMethod::Stored && size == packed)
             .then(|| member.data_start())
             .flatten()
             .filter(|&start| start.checked_add(size).is_some_and(|end| end <= file_size));

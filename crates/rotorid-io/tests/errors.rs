@@ -317,3 +317,30 @@ fn a_stored_npz_member_that_fails_its_crc_is_refused() {
     }
     assert!(read_bytes(Format::Npz, "good.npz", &good).is_ok());
 }
+
+/// A stored NPZ member whose central directory declares fewer uncompressed bytes than it
+/// stores is refused (it is not read short), from bytes and from disk.
+#[test]
+fn a_stored_npz_member_with_disagreeing_sizes_is_refused() {
+    let mut bad = fixture("rec.npz");
+    // x.npy's central directory entry is at 7955; its uncompressed size at +24
+    assert_eq!(&bad[7955 + 46..7955 + 51], b"x.npy");
+    bad[7955 + 24..7955 + 28].copy_from_slice(&2000u32.to_le_bytes());
+    // ... and a CRC-32 that fits the first 2000 stored bytes (data at 2231 + 30 + 5 + 20),
+    // so that only the sizes' disagreement can refuse it
+    let crc = crc32fast::hash(&bad[2286..2286 + 2000]);
+    bad[7955 + 16..7955 + 20].copy_from_slice(&crc.to_le_bytes());
+    let path = std::env::temp_dir().join(format!("rotorid-sizes-{}.npz", std::process::id()));
+    std::fs::write(&path, &bad).unwrap();
+    let from_disk = rotorid_io::read_table(&path);
+    std::fs::remove_file(&path).unwrap();
+    for e in [
+        read_bytes(Format::Npz, "bad.npz", &bad).unwrap_err(),
+        from_disk.unwrap_err(),
+    ] {
+        let msg = e.to_string();
+        assert!(msg.contains("channel \"x\""), "{msg}");
+        assert!(msg.contains("inflated size"), "{msg}");
+        assert!(msg.contains("the declared 2000"), "{msg}");
+    }
+}
