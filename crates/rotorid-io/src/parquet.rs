@@ -349,24 +349,27 @@ fn check_pages(
         })?;
     let mut pos = start;
     while pos < end {
-        // The page header from the first HEADER_WINDOW bytes at `pos`, or from the rest of
-        // the chunk when it runs past them: a walk that succeeds on a prefix reads the same
-        // bytes in the whole, and the boolean budget is the chunk's length either way. The
-        // pages' contents are not read here (the parquet crate reads them once).
+        // The page header from the first HEADER_WINDOW bytes at `pos`, or from a window 16
+        // times longer each time it runs past one, up to the rest of the chunk: a walk that
+        // succeeds on a prefix reads the same bytes in the whole, and the boolean budget is
+        // the chunk's length either way. What is read per page stays within 16 times its
+        // header plus a window, and the pages' contents are not read here (the parquet crate
+        // reads them once).
         let rest = end - pos;
-        let mut header = None;
-        for n in [rest.min(HEADER_WINDOW), rest] {
-            let bytes = chunk(pos, n)?;
+        let mut n = HEADER_WINDOW;
+        let header = loop {
+            let bytes = chunk(pos, n.min(rest))?;
             let mut t = Thrift {
                 b: &bytes,
                 i: 0,
                 bools: len,
             };
-            header = t.page_header().map(|h| (h, t.i as u64));
-            if header.is_some() || n == rest {
-                break;
+            let header = t.page_header().map(|h| (h, t.i as u64));
+            if header.is_some() || n >= rest {
+                break header;
             }
-        }
+            n = n.saturating_mul(16);
+        };
         let ((unc, comp), header_len) = header.ok_or_else(|| {
             bad(
                 pos,
@@ -403,7 +406,7 @@ fn check_pages(
 }
 
 /// Bytes read at a page's start to walk its header (a page header of a numeric column is
-/// tens of bytes; a longer one is walked in the rest of its chunk).
+/// tens of bytes; a longer one is walked in longer windows).
 const HEADER_WINDOW: u64 = 4096;
 
 /// Deepest nesting of Thrift structures and containers walked (the `parquet` crate's skip
@@ -868,6 +871,27 @@ mod tests {
             *reads.borrow(),
             vec![(0, HEADER_WINDOW), (0, size), (second as u64, rest)]
         );
+
+        // a header past the first window of a long chunk: the next window, not the rest
+        let mut long = header(10, 10, 6000);
+        long.extend([7u8; 10]);
+        long.extend(std::iter::repeat_n(0u8, 200_000));
+        let reads = RefCell::new(Vec::new());
+        let read = |at: u64, len: u64| {
+            reads.borrow_mut().push((at, len));
+            Ok(long[at as usize..(at + len) as usize].to_vec())
+        };
+        let page = (header(10, 10, 6000).len() + 10) as i64;
+        check_pages("f.parquet", long.len() as u64, &read, "x", 0, page).unwrap();
+        assert_eq!(*reads.borrow(), vec![(0, HEADER_WINDOW), (0, page as u64)]);
+        reads.borrow_mut().clear();
+        // over the whole buffer: the first header needs the second window (4 KiB, then
+        // 64 KiB, not the 200 KB rest), and the zeros after the page are no page header
+        // (refused)
+        let all = long.len() as i64;
+        assert!(check_pages("f.parquet", long.len() as u64, &read, "x", 0, all).is_err());
+        let lens: Vec<u64> = reads.borrow().iter().map(|r| r.1).collect();
+        assert_eq!(lens[..2], [HEADER_WINDOW, 16 * HEADER_WINDOW]);
 
         // the long header cut short: refused at its page, after the whole rest was tried
         let cut = 5000;
