@@ -173,14 +173,19 @@ fn parquet_with_footer(footer: &[u8]) -> Vec<u8> {
     b
 }
 
-fn assert_footer_refused(name: &str, bytes: &[u8], offset: u64) {
+/// The refusals of `bytes` as the file `name`, read from memory and from disk.
+fn refusals(format: Format, name: &str, bytes: &[u8]) -> [ReadError; 2] {
     let tmp = tempfile::tempdir().unwrap();
     let path = tmp.path().join(name);
     std::fs::write(&path, bytes).unwrap();
-    for e in [
-        read_bytes(Format::Parquet, name, bytes).unwrap_err(),
+    [
+        read_bytes(format, name, bytes).unwrap_err(),
         rotorid_io::read_table(&path).unwrap_err(),
-    ] {
+    ]
+}
+
+fn assert_footer_refused(name: &str, bytes: &[u8], offset: u64) {
+    for e in refusals(Format::Parquet, name, bytes) {
         match &e {
             ReadError::Invalid {
                 what, offset: at, ..
@@ -302,14 +307,7 @@ fn a_stored_npz_member_that_fails_its_crc_is_refused() {
     let data = 2231 + 30 + "x.npy".len() + 20;
     let at = data + 200;
     bad[at] ^= 0x40;
-    let path = std::env::temp_dir().join(format!("rotorid-crc-{}.npz", std::process::id()));
-    std::fs::write(&path, &bad).unwrap();
-    let from_disk = rotorid_io::read_table(&path);
-    std::fs::remove_file(&path).unwrap();
-    for e in [
-        read_bytes(Format::Npz, "bad.npz", &bad).unwrap_err(),
-        from_disk.unwrap_err(),
-    ] {
+    for e in refusals(Format::Npz, "bad.npz", &bad) {
         let msg = e.to_string();
         assert!(msg.contains("CRC-32"), "{msg}");
         assert!(msg.contains("channel \"x\""), "{msg}");
@@ -330,14 +328,7 @@ fn a_stored_npz_member_with_disagreeing_sizes_is_refused() {
     // so that only the sizes' disagreement can refuse it
     let crc = crc32fast::hash(&bad[2286..2286 + 2000]);
     bad[7955 + 16..7955 + 20].copy_from_slice(&crc.to_le_bytes());
-    let path = std::env::temp_dir().join(format!("rotorid-sizes-{}.npz", std::process::id()));
-    std::fs::write(&path, &bad).unwrap();
-    let from_disk = rotorid_io::read_table(&path);
-    std::fs::remove_file(&path).unwrap();
-    for e in [
-        read_bytes(Format::Npz, "bad.npz", &bad).unwrap_err(),
-        from_disk.unwrap_err(),
-    ] {
+    for e in refusals(Format::Npz, "bad.npz", &bad) {
         let msg = e.to_string();
         assert!(msg.contains("channel \"x\""), "{msg}");
         assert!(msg.contains("inflated size"), "{msg}");
