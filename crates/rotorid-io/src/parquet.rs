@@ -16,7 +16,10 @@
 //! to check that its compressed size lies within the file and its uncompressed size is at
 //! most 1032 times that plus 1 KiB, since the `parquet` crate allocates a page's claimed
 //! uncompressed size before decompressing. Errors of the `parquet` crate are reported as
-//! [`ReadError::Container`] with its message.
+//! [`ReadError::Container`] with its message. Each column chunk is decoded under its own
+//! guard ([`crate::guard`]): should the crate panic on a malformed page, the error names
+//! the column, the row group and the chunk's byte offset, as a null or an inexact integer
+//! does.
 
 use bytes::Bytes;
 use parquet::basic::{ConvertedType, Type as Physical};
@@ -157,90 +160,18 @@ fn read_inner<R: ChunkReader + 'static>(
         // footer cannot make this allocation larger than 8 bytes per byte of the file.
         let mut data: Vec<f64> = Vec::with_capacity((rows as u64).min(size) as usize);
         for rg in 0..reader.num_row_groups() {
-            let group = reader
-                .get_row_group(rg)
-                .map_err(|e| err(file, Some(&name), e))?;
-            let mut col_reader = group
-                .get_column_reader(col)
-                .map_err(|e| err(file, Some(&name), e))?;
-            let mut defs: Vec<i16> = Vec::new();
-            let mut row0 = 0usize;
-            loop {
-                defs.clear();
-                let def = (max_def > 0).then_some(&mut defs);
-                let n = match &mut col_reader {
-                    ColumnReader::DoubleColumnReader(r) => {
-                        // (the values are appended to `data`, decoded in place)
-                        let (recs, _, _) = r
-                            .read_records(BATCH, def, None, &mut data)
-                            .map_err(|e| err(file, Some(&name), e))?;
-                        recs
-                    }
-                    ColumnReader::FloatColumnReader(r) => {
-                        let mut v = Vec::new();
-                        let (recs, _, _) = r
-                            .read_records(BATCH, def, None, &mut v)
-                            .map_err(|e| err(file, Some(&name), e))?;
-                        data.extend(v.into_iter().map(f64::from));
-                        recs
-                    }
-                    ColumnReader::Int32ColumnReader(r) => {
-                        let mut v = Vec::new();
-                        let (recs, _, _) = r
-                            .read_records(BATCH, def, None, &mut v)
-                            .map_err(|e| err(file, Some(&name), e))?;
-                        match kind {
-                            Kind::Unsigned => {
-                                data.extend(v.into_iter().map(|x| f64::from(x as u32)))
-                            }
-                            _ => data.extend(v.into_iter().map(f64::from)),
-                        }
-                        recs
-                    }
-                    ColumnReader::Int64ColumnReader(r) => {
-                        let mut v = Vec::new();
-                        let (recs, _, _) = r
-                            .read_records(BATCH, def, None, &mut v)
-                            .map_err(|e| err(file, Some(&name), e))?;
-                        for x in v {
-                            let wide = match kind {
-                                Kind::Unsigned => i128::from(x as u64),
-                                _ => i128::from(x),
-                            };
-                            let f = wide as f64;
-                            if f as i128 != wide {
-                                return Err(ReadError::InexactInteger {
-                                    file: file.to_string(),
-                                    channel: name,
-                                    index: data.len(),
-                                    offset: 0,
-                                    value: wide,
-                                });
-                            }
-                            data.push(f);
-                        }
-                        recs
-                    }
-                    _ => return Err(err(file, Some(&name), "unexpected column reader")),
-                };
-                if let Some(i) = defs.iter().position(|&d| d < max_def) {
-                    return Err(ReadError::Invalid {
-                        file: file.to_string(),
-                        channel: Some(name),
-                        offset: 0,
-                        what: format!("Parquet row {} of row group {rg}", row0 + i),
-                        found: "a null".into(),
-                        allowed: "a value in every row".into(),
-                    });
-                }
-                if n == 0 {
-                    break;
-                }
-                row0 += n;
-                if data.len() as u64 > limit {
-                    return Err(err(file, Some(&name), format!("more than {limit} values")));
-                }
-            }
+            let cc = meta.row_group(rg).column(col);
+            let at = Chunk {
+                name: &name,
+                row_group: rg,
+                offset: cc.dictionary_page_offset().unwrap_or(cc.data_page_offset()) as u64,
+                len: cc.compressed_size() as u64,
+            };
+            // A panic of the crate in this column chunk names it (crate::guard).
+            crate::guard::quietly(|| {
+                read_chunk(file, &reader, col, kind, max_def, limit, &at, &mut data)
+            })
+            .unwrap_or_else(|| Err(at.undecodable(file)))?;
         }
         channels.push(Channel {
             name,
@@ -263,6 +194,134 @@ fn read_inner<R: ChunkReader + 'static>(
         file: file.to_string(),
         channels,
     })
+}
+
+/// Where a column chunk lies: its column, row group and bytes (from the footer, checked
+/// against the file by [`check_pages`]).
+struct Chunk<'a> {
+    name: &'a str,
+    row_group: usize,
+    /// Byte offset of its first page (the dictionary page when it has one).
+    offset: u64,
+    /// Its compressed size \[bytes\].
+    len: u64,
+}
+
+impl Chunk<'_> {
+    /// The error for a chunk on which the `parquet` crate panicked.
+    fn undecodable(&self, file: &str) -> ReadError {
+        ReadError::Invalid {
+            file: file.to_string(),
+            channel: Some(self.name.to_string()),
+            offset: self.offset,
+            what: format!(
+                "the Parquet column chunk of row group {} ({} bytes)",
+                self.row_group, self.len
+            ),
+            found: "malformed: the parquet reader failed on it".into(),
+            allowed: "pages as the Parquet format specifies them".into(),
+        }
+    }
+}
+
+/// The values of column `col` in the row group and column chunk `at`, appended to `data`.
+#[allow(clippy::too_many_arguments)]
+fn read_chunk<R: ChunkReader + 'static>(
+    file: &str,
+    reader: &SerializedFileReader<R>,
+    col: usize,
+    kind: Kind,
+    max_def: i16,
+    limit: u64,
+    at: &Chunk<'_>,
+    data: &mut Vec<f64>,
+) -> Result<(), ReadError> {
+    let (name, rg) = (at.name, at.row_group);
+    let group = reader
+        .get_row_group(rg)
+        .map_err(|e| err(file, Some(name), e))?;
+    let mut col_reader = group
+        .get_column_reader(col)
+        .map_err(|e| err(file, Some(name), e))?;
+    let mut defs: Vec<i16> = Vec::new();
+    let mut row0 = 0usize;
+    loop {
+        defs.clear();
+        let def = (max_def > 0).then_some(&mut defs);
+        let n = match &mut col_reader {
+            ColumnReader::DoubleColumnReader(r) => {
+                // (the values are appended to `data`, decoded in place)
+                let (recs, _, _) = r
+                    .read_records(BATCH, def, None, data)
+                    .map_err(|e| err(file, Some(name), e))?;
+                recs
+            }
+            ColumnReader::FloatColumnReader(r) => {
+                let mut v = Vec::new();
+                let (recs, _, _) = r
+                    .read_records(BATCH, def, None, &mut v)
+                    .map_err(|e| err(file, Some(name), e))?;
+                data.extend(v.into_iter().map(f64::from));
+                recs
+            }
+            ColumnReader::Int32ColumnReader(r) => {
+                let mut v = Vec::new();
+                let (recs, _, _) = r
+                    .read_records(BATCH, def, None, &mut v)
+                    .map_err(|e| err(file, Some(name), e))?;
+                match kind {
+                    Kind::Unsigned => data.extend(v.into_iter().map(|x| f64::from(x as u32))),
+                    _ => data.extend(v.into_iter().map(f64::from)),
+                }
+                recs
+            }
+            ColumnReader::Int64ColumnReader(r) => {
+                let mut v = Vec::new();
+                let (recs, _, _) = r
+                    .read_records(BATCH, def, None, &mut v)
+                    .map_err(|e| err(file, Some(name), e))?;
+                for x in v {
+                    let wide = match kind {
+                        Kind::Unsigned => i128::from(x as u64),
+                        _ => i128::from(x),
+                    };
+                    let f = wide as f64;
+                    if f as i128 != wide {
+                        return Err(ReadError::InexactInteger {
+                            file: file.to_string(),
+                            channel: name.to_string(),
+                            index: data.len(),
+                            offset: at.offset,
+                            value: wide,
+                        });
+                    }
+                    data.push(f);
+                }
+                recs
+            }
+            _ => return Err(err(file, Some(name), "unexpected column reader")),
+        };
+        if let Some(i) = defs.iter().position(|&d| d < max_def) {
+            return Err(ReadError::Invalid {
+                file: file.to_string(),
+                channel: Some(name.to_string()),
+                offset: at.offset,
+                what: format!(
+                    "row {} of row group {rg}, in the Parquet column chunk",
+                    row0 + i
+                ),
+                found: "a null".into(),
+                allowed: "a value in every row".into(),
+            });
+        }
+        if n == 0 {
+            return Ok(());
+        }
+        row0 += n;
+        if data.len() as u64 > limit {
+            return Err(err(file, Some(name), format!("more than {limit} values")));
+        }
+    }
 }
 
 /// Walks the Thrift footer (FileMetaData) the way the `parquet` crate will, before it

@@ -159,9 +159,33 @@ fn parquet_nulls_are_refused_naming_the_row() {
     let e = read_bytes(Format::Parquet, "nulls.parquet", &fixture("nulls.parquet")).unwrap_err();
     let msg = e.to_string();
     assert!(
-        msg.contains("channel \"x\"") && msg.contains("row 1 of row group 0"),
+        msg.contains("channel \"x\"")
+            && msg.contains("row 1 of row group 0")
+            // the column chunk's first page: right after the leading magic `PAR1`
+            && msg.contains("at byte 4 is a null"),
         "{msg}"
     );
+}
+
+#[test]
+fn a_column_chunk_the_parquet_crate_panics_on_is_named_with_its_offset() {
+    // A BYTE_STREAM_SPLIT page shorter than its value count (found by fuzzing): the crate
+    // indexes out of bounds in column z's chunk of row group 0, whose first page header is
+    // at byte 1569 and which the footer gives 575 bytes (the next header follows them).
+    let bytes = fixture("panic_bss.parquet");
+    assert_eq!(bytes[1569], 0x15, "a page header's first field");
+    assert_eq!(bytes[1569 + 575], 0x15, "the next page header");
+    for e in refusals(Format::Parquet, "panic_bss.parquet", &bytes) {
+        match &e {
+            ReadError::Invalid {
+                channel: Some(channel),
+                offset: 1569,
+                what,
+                ..
+            } if channel == "z" && what.contains("row group 0 (575 bytes)") => {}
+            _ => panic!("{e}"),
+        }
+    }
 }
 
 /// `PAR1`, `footer`, its length and `PAR1`: a Parquet file with no data.

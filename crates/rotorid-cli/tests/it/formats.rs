@@ -479,7 +479,9 @@ fn circles(svg: &str) -> Vec<(f64, f64)> {
 fn a_panic_of_the_parquet_crate_is_an_error_without_a_panic_message() {
     // Found by fuzzing read_parquet: a BYTE_STREAM_SPLIT page shorter than its value count,
     // on which the parquet crate (59.3.2) indexes out of bounds. rotorid reports an error
-    // naming the file, exits 1, and prints no "panicked" line or backtrace.
+    // naming the file, the column, its row group and the column chunk's offset (1569: the
+    // page header there begins the 575 bytes the footer gives it, and the next header
+    // follows them), exits 1, and prints no "panicked" line or backtrace.
     let fixture = format!(
         "{}/../rotorid-io/fixtures/panic_bss.parquet",
         env!("CARGO_MANIFEST_DIR")
@@ -494,7 +496,10 @@ fn a_panic_of_the_parquet_crate_is_an_error_without_a_panic_message() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{command}: {stderr}");
         assert!(
-            stderr.contains("panic_bss.parquet: Parquet: the parquet reader failed"),
+            stderr.contains(
+                "panic_bss.parquet, channel \"z\": the Parquet column chunk of row group 0 \
+                 (575 bytes) at byte 1569 is malformed: the parquet reader failed on it"
+            ),
             "{command}: {stderr}"
         );
         assert!(!stderr.contains("panicked"), "{command}: {stderr}");
