@@ -227,7 +227,11 @@ const UNITS: &[(&str, &str, Quantity, Scale)] = {
         ("deg/s^2", "deg/s^2", AngularAcceleration, Mul(DEG)),
         ("deg/s2", "deg/s^2", AngularAcceleration, Mul(DEG)),
         ("v", "V", Voltage, Identity),
+        ("volt", "V", Voltage, Identity),
+        ("volts", "V", Voltage, Identity),
         ("mv", "mV", Voltage, Div(1e3)),
+        ("millivolt", "mV", Voltage, Div(1e3)),
+        ("millivolts", "mV", Voltage, Div(1e3)),
     ]
 };
 
