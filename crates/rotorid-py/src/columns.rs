@@ -118,17 +118,18 @@ impl<'a> Columns<'a> {
 pub const SPEED_NAMES: [&str; 3] = ["phi", "phi_dot", "phi_ddot"];
 
 /// The estimates table's columns, as `rotorid identify --out` writes them.
-pub const ESTIMATE_COLUMNS: [&str; 9] = [
-    "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z",
+pub const ESTIMATE_COLUMNS: [&str; 10] = [
+    "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z", "window",
 ];
 
 /// Estimates, one row per estimate, in columns [`ESTIMATE_COLUMNS`]: t \[s\], m \[kg\],
 /// c \[N s/m\], k \[N/m\] per direction (NaN where the CLI leaves the field empty: an
-/// ill-conditioned direction, a value not determined), rcond per direction.
+/// ill-conditioned direction, a value not determined), rcond per direction, and the
+/// algebraic estimate's restart window (0, 1, 2, ...; NaN on a batch method's row).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Estimates {
     /// The columns, in the order of [`ESTIMATE_COLUMNS`].
-    pub columns: [Vec<f64>; 9],
+    pub columns: [Vec<f64>; 10],
 }
 
 impl Estimates {
@@ -157,6 +158,8 @@ impl Estimates {
             keep(est.z.k, ok_z),
             est.x.rcond,
             est.z.rcond,
+            // (exact: a window index is far below 2^53)
+            e.window as f64,
         ];
         self.push(row);
     }
@@ -165,7 +168,16 @@ impl Estimates {
     pub fn push_final(&mut self, f: &FinalEstimate) {
         let v = f.values.map(|v| v.unwrap_or(f64::NAN));
         self.push([
-            f.t_s, v[0], v[1], v[2], v[3], v[4], v[5], f.rcond.x, f.rcond.z,
+            f.t_s,
+            v[0],
+            v[1],
+            v[2],
+            v[3],
+            v[4],
+            v[5],
+            f.rcond.x,
+            f.rcond.z,
+            f64::NAN,
         ]);
     }
 
@@ -180,7 +192,7 @@ impl Estimates {
         }
     }
 
-    fn push(&mut self, row: [f64; 9]) {
+    fn push(&mut self, row: [f64; 10]) {
         for (c, v) in self.columns.iter_mut().zip(row) {
             c.push(v);
         }

@@ -46,6 +46,7 @@ x = 1.0e-5
 CASES = [
     ("algebraic", {}),
     ("algebraic", {"quadrature": "trapezoid", "tol": 0.05, "rcond_min": 1e-6}),
+    ("algebraic", {"restart": 0.05}),
     ("modulating", {}),
     ("modulating", {"window": 0.03}),
     ("refine", {}),

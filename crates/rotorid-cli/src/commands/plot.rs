@@ -43,7 +43,7 @@ use crate::io::tables;
 use crate::io::LoadScenario as _;
 use crate::io::{
     check_distinct_files, open_input, EstimatesReader, ResponseReader, ScenarioSpec, Truth,
-    ESTIMATES_HEADER,
+    ESTIMATES_HEADER, ESTIMATES_REQUIRED,
 };
 use crate::plot::scale::si_prefix;
 use crate::plot::thin::{ColumnThinner, PathThinner, Subsample};
@@ -226,7 +226,7 @@ pub fn detect(name: &str, head: &[u8]) -> anyhow::Result<CsvKind> {
     };
     let names: Vec<String> = rec.iter().map(normalise).collect();
     let has = |n: &str| names.iter().any(|h| h == n);
-    if ESTIMATES_HEADER[1..].iter().any(|n| has(n)) {
+    if ESTIMATES_REQUIRED[1..].iter().any(|n| has(n)) {
         Ok(CsvKind::Estimates)
     } else if has("t") && (has("x") || has("z")) {
         Ok(CsvKind::Response)

@@ -3,11 +3,15 @@
 //! (docs/method.md section 3.4, `A(t) theta = b(t)`).
 //!
 //! ```text
-//! t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z
-//! s,kg,N s/m,N/m,kg,N s/m,N/m,1,1          (units, not written)
+//! t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z,window
+//! s,kg,N s/m,N/m,kg,N s/m,N/m,1,1,-        (units, not written)
 //! ```
 //!
 //! - `t` is the sample's time as read from the input.
+//! - `window` is the algebraic estimate's restart window (`--restart`; docs/method.md
+//!   section 3.9): 0, 1, 2, ... in the order they start, 0 throughout without restarts. A
+//!   batch method's one row leaves it empty. Files written before it existed (nine columns)
+//!   are still read.
 //! - `rcond_x`, `rcond_z` are the identifier's reciprocal condition numbers of the scaled
 //!   3x3 system A(t) (dimensionless, in [0, 1]; 0 when exactly singular), always written.
 //! - When a direction is not well conditioned at an instant (rcond below `--rcond-min`,
@@ -29,7 +33,12 @@ use rotorid_io::csv::CsvError;
 use super::params::ParameterSet;
 
 /// The header `identify` writes.
-pub const ESTIMATES_HEADER: [&str; 9] = [
+pub const ESTIMATES_HEADER: [&str; 10] = [
+    "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z", "window",
+];
+
+/// The columns an estimates file must have (`window` came later and may be absent).
+pub const ESTIMATES_REQUIRED: [&str; 9] = [
     "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z",
 ];
 
@@ -46,12 +55,15 @@ pub fn estimates_parquet(
         .collect();
     let rcond_x: Vec<f64> = rows.iter().map(|r| r.rcond_x).collect();
     let rcond_z: Vec<f64> = rows.iter().map(|r| r.rcond_z).collect();
+    // (a whole number, exact as a double: the column is a double like the others)
+    let window: Vec<Option<f64>> = rows.iter().map(|r| r.window.map(|w| w as f64)).collect();
     let mut columns = vec![(ESTIMATES_HEADER[0], ParquetColumn::Required(&t))];
     for (k, v) in values.iter().enumerate() {
         columns.push((ESTIMATES_HEADER[1 + k], ParquetColumn::Optional(v)));
     }
     columns.push((ESTIMATES_HEADER[7], ParquetColumn::Required(&rcond_x)));
     columns.push((ESTIMATES_HEADER[8], ParquetColumn::Required(&rcond_z)));
+    columns.push((ESTIMATES_HEADER[9], ParquetColumn::Optional(&window)));
     parquet_columns_bytes(file, &columns)
 }
 
@@ -66,6 +78,9 @@ pub struct EstimateRow {
     pub rcond_x: f64,
     /// Reciprocal condition number of the z system (dimensionless, [0, 1]).
     pub rcond_z: f64,
+    /// The algebraic estimate's restart window (0 without restarts); `None` for a batch
+    /// method's row, and in files written without the column.
+    pub window: Option<u64>,
 }
 
 /// Writes the estimates CSV (header first), one whole row per `write_all`.
@@ -100,6 +115,8 @@ impl<W: Write> EstimatesWriter<W> {
                 v.k_z,
                 Some(r.rcond_x),
                 Some(r.rcond_z),
+                // (exact: a window index is far below 2^53)
+                r.window.map(|w| w as f64),
             ],
         )
     }
@@ -115,14 +132,16 @@ impl<W: Write> EstimatesWriter<W> {
     }
 }
 
-/// Streaming reader of an estimates CSV: all nine columns required (any order, extra
-/// columns ignored, unit suffixes allowed as in [`super::columns`]); `t` finite; parameter
-/// fields empty, `NaN` (both `None`) or a number; rcond a number.
+/// Streaming reader of an estimates CSV: the nine columns of [`ESTIMATES_REQUIRED`]
+/// required and `window` read when present (any order, extra columns ignored, unit suffixes
+/// allowed as in [`super::columns`]); `t` finite; parameter fields empty, `NaN` (both
+/// `None`) or a number; rcond a number; window empty or a whole number >= 0.
 pub struct EstimatesReader<R: Read> {
     file: String,
     csv: CsvReader<R>,
     header: Header,
     cols: Vec<usize>,
+    window: Option<usize>,
 }
 
 impl<R: Read> EstimatesReader<R> {
@@ -139,12 +158,14 @@ impl<R: Read> EstimatesReader<R> {
             ));
         };
         let header = Header::new(&rec, rec.line());
-        let cols = header.require(file, &ESTIMATES_HEADER)?;
+        let cols = header.require(file, &ESTIMATES_REQUIRED)?;
+        let window = header.find(file, "window")?;
         Ok(Self {
             file: file.to_owned(),
             csv,
             header,
             cols,
+            window,
         })
     }
 
@@ -159,6 +180,25 @@ impl<R: Read> EstimatesReader<R> {
         check_length(f, rec, line, &self.header)?;
         let c = &self.cols;
         let opt = |i: usize| optional_field(f, rec, line, c[i], ESTIMATES_HEADER[i]);
+        let window = match self.window {
+            None => None,
+            Some(col) => match optional_field(f, rec, line, col, "window")? {
+                None => None,
+                Some(w) if w >= 0.0 && w.fract() == 0.0 && w <= 2f64.powi(53) => Some(w as u64),
+                Some(w) => {
+                    return Err(rotorid_io::csv::CsvError::field(
+                        f,
+                        line,
+                        col,
+                        "window",
+                        format!(
+                            "window {w} is not a restart window: allowed a whole number >= 0, \
+                             or empty"
+                        ),
+                    ))
+                }
+            },
+        };
         Ok(Some(EstimateRow {
             t: finite_field(f, rec, line, c[0], "t")?,
             values: ParameterSet {
@@ -171,6 +211,7 @@ impl<R: Read> EstimatesReader<R> {
             },
             rcond_x: number_field(f, rec, line, c[7], "rcond_x")?,
             rcond_z: number_field(f, rec, line, c[8], "rcond_z")?,
+            window,
         }))
     }
 }
@@ -187,6 +228,7 @@ mod tests {
                 values: ParameterSet::default(),
                 rcond_x: 0.0,
                 rcond_z: 0.0,
+                window: Some(0),
             },
             EstimateRow {
                 t: 1e-4,
@@ -198,6 +240,14 @@ mod tests {
                 },
                 rcond_x: 1.5e-3,
                 rcond_z: 2e-9,
+                window: Some(12),
+            },
+            EstimateRow {
+                t: 2e-4,
+                values: ParameterSet::default(),
+                rcond_x: 1.0,
+                rcond_z: 1.0,
+                window: None,
             },
         ];
         let mut w = EstimatesWriter::new(Vec::new()).unwrap();
@@ -207,30 +257,42 @@ mod tests {
         let text = String::from_utf8(w.into_inner()).unwrap();
         assert_eq!(
             text,
-            "t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z\n0,,,,,,,0,0\n\
-             0.0001,14.29,10.0000001,1195000,,,,0.0015,2e-9\n"
+            "t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z,window\n0,,,,,,,0,0,0\n\
+             0.0001,14.29,10.0000001,1195000,,,,0.0015,2e-9,12\n0.0002,,,,,,,1,1,\n"
         );
         let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
-        assert_eq!(r.next_row().unwrap(), Some(rows[0]));
-        assert_eq!(r.next_row().unwrap(), Some(rows[1]));
+        for row in &rows {
+            assert_eq!(r.next_row().unwrap().as_ref(), Some(row));
+        }
         assert_eq!(r.next_row().unwrap(), None);
     }
 
     #[test]
     fn nan_reads_as_missing_and_errors_are_located() {
         let h = ESTIMATES_HEADER.join(",");
-        let text = format!("{h}\n0,NaN,1,2,3,4,5,0.1,0.2\n");
+        let text = format!("{h}\n0,NaN,1,2,3,4,5,0.1,0.2,0\n");
         let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
         let row = r.next_row().unwrap().unwrap();
         assert_eq!(row.values.m_x, None);
         assert_eq!(row.values.k_z, Some(5.0));
-        let text = format!("{h}\n0,1,x,2,3,4,5,0.1,0.2\n");
+        let text = format!("{h}\n0,1,x,2,3,4,5,0.1,0.2,0\n");
         let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
         assert!(r
             .next_row()
             .unwrap_err()
             .to_string()
             .starts_with("e.csv line 2, column 3 (c_x): c_x \"x\" is not a number"));
+        // a file of nine columns (before `window`) reads with no window
+        let old = "t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z\n0,1,2,3,4,5,6,0.1,0.2\n";
+        let mut r = EstimatesReader::new("e.csv", old.as_bytes()).unwrap();
+        assert_eq!(r.next_row().unwrap().unwrap().window, None);
+        // a window that is no window
+        for bad in ["-1", "1.5", "inf"] {
+            let text = format!("{h}\n0,1,2,3,4,5,6,0.1,0.2,{bad}\n");
+            let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
+            let e = r.next_row().unwrap_err().to_string();
+            assert!(e.starts_with("e.csv line 2, column 10 (window): "), "{e}");
+        }
         let e = EstimatesReader::new("e.csv", "t,m_x\n".as_bytes())
             .err()
             .unwrap();

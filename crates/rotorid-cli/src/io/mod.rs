@@ -4,7 +4,7 @@
 //! |---|---|---|---|
 //! | scenario TOML (rotor, speed, sampling, initial state; SI) | [`scenario`] | you | simulate, identify |
 //! | response CSV `t,x,z,phi,phi_dot,phi_ddot` (s, m, m, rad, rad/s, rad/s^2) | [`response_csv`] | simulate | identify, plot |
-//! | estimates CSV `t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z` | [`estimates_csv`] | identify | plot |
+//! | estimates CSV `t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z,window` | [`estimates_csv`] | identify | plot |
 //! | summary JSON: the serialised `rotorid::pipeline::Identification` (docs/summary.md) | - | identify | scripts |
 //! | summary JSON: identified `rotor`, `covariance` | [`identified`] | identify | analyze, balance |
 //!
@@ -27,7 +27,9 @@ pub mod response_csv;
 pub mod scenario;
 pub mod tables;
 
-pub use estimates_csv::{EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES_HEADER};
+pub use estimates_csv::{
+    EstimateRow, EstimatesReader, EstimatesWriter, ESTIMATES_HEADER, ESTIMATES_REQUIRED,
+};
 pub use output::{
     check_distinct_files, is_broken_pipe, open_input, stdout_error, FileMode, Output, StdoutClosed,
 };

@@ -55,7 +55,7 @@ fn refused(input: &str, args: &[&str]) -> String {
     err
 }
 
-const HEADER: &str = "t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z";
+const HEADER: &str = "t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z,window";
 
 #[test]
 fn pipeline_recovers_table1_and_writes_every_summary_field() {
@@ -129,13 +129,37 @@ fn pipeline_recovers_table1_and_writes_every_summary_field() {
 }
 
 #[test]
+fn the_window_column_says_which_restart_window_each_estimate_is_from() {
+    // --restart 0.1 s at dt = 1e-4 s: period P = 1000 samples, H = 500; sample i reports
+    // window max(0, floor(i / H) - 1) (docs/method.md section 3.9)
+    let window_of = |out: &str| -> Vec<u64> {
+        let mut lines = out.lines();
+        assert_eq!(lines.next(), Some(HEADER));
+        lines
+            .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+            .collect()
+    };
+    let (ok, out, err) = identify(table1_csv(), &["-q", "--restart", "0.1"]);
+    assert!(ok, "{err}");
+    let w = window_of(&out);
+    assert_eq!(w.len(), 3001);
+    for (i, &w) in w.iter().enumerate() {
+        assert_eq!(w, (i as u64 / 500).saturating_sub(1), "sample {i}");
+    }
+    // without restarts, one window
+    let (ok, out, err) = identify(table1_csv(), &["-q"]);
+    assert!(ok, "{err}");
+    assert!(window_of(&out).iter().all(|&w| w == 0));
+}
+
+#[test]
 fn singular_instants_are_empty_fields() {
     // At the old threshold 1e-9 only t_0 .. t_2 are flagged on this record (the default,
     // the library's calibrated 1e-5, also flags a few near-singular instants later on).
     let (ok, out, _) = identify(table1_csv(), &["-q", "--rcond-min", "1e-9"]);
     assert!(ok);
     let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines[1], "0,,,,,,,0,0");
+    assert_eq!(lines[1], "0,,,,,,,0,0,0");
     assert!(lines[2].starts_with("0.0001,,,,,,,0,"));
     // From the 4th sample on, every field is a number.
     for l in &lines[10..] {
@@ -406,7 +430,7 @@ fn output_before_an_error_is_whole_rows() {
     assert_eq!(rows[0], HEADER);
     assert_eq!(rows.len(), 1 + 999, "every row before the bad one");
     for r in &rows[1..] {
-        assert_eq!(r.split(',').count(), 9, "{r}");
+        assert_eq!(r.split(',').count(), 10, "{r}");
     }
 }
 

@@ -56,7 +56,7 @@ fn rms(v: &[f64]) -> f64 {
 fn estimates_row(csv: &str) -> Vec<Option<f64>> {
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 2, "a header and one row: {csv}");
-    assert_eq!(lines[0], "t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z");
+    assert_eq!(lines[0], "t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z,window");
     lines[1]
         .split(',')
         .map(|f| (!f.is_empty()).then(|| f.parse().unwrap()))

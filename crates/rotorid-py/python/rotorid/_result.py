@@ -39,9 +39,11 @@ class Identification:
             where not determined or not given.
         warnings: the diagnostics' messages, worst first (what the CLI prints as warnings).
         estimates: DataFrame t [s], m_x, c_x, k_x, m_z, c_z, k_z [kg, N s/m, N/m],
-            rcond_x, rcond_z: algebraic: one row per sample, values NaN where a direction
-            is ill-conditioned (the CLI leaves them empty); modulating and refine: the one
-            row the CLI writes.
+            rcond_x, rcond_z, window: algebraic: one row per sample, values NaN where a
+            direction is ill-conditioned (the CLI leaves them empty), window the restart
+            window of the estimate (``restart``; 0.0, 1.0, ... as they start, 0.0 throughout
+            without restarts); modulating and refine: the one row the CLI writes (window
+            NaN).
         core_seconds: time spent in the library (identify only; for benchmarks).
     """
 

@@ -231,6 +231,7 @@ pub(crate) fn identify(
         values: ParameterSet::from_array(f.values),
         rcond_x: f.rcond.x,
         rcond_z: f.rcond.z,
+        window: None,
     });
     if let Some(mut table) = parquet {
         table.extend(last);
@@ -441,5 +442,6 @@ fn row_of(e: &SampleEstimate) -> EstimateRow {
         },
         rcond_x: est.x.rcond,
         rcond_z: est.z.rcond,
+        window: Some(e.window),
     }
 }
