@@ -71,35 +71,44 @@ fn exact(v: i128, index: usize) -> Result<f64, Inexact> {
     }
 }
 
-macro_rules! gather {
-    ($data:expr, $start:expr, $count:expr, $stride:expr, $n:literal, $e:expr, $out:expr, |$a:ident| $conv:expr) => {{
-        // The elements' bytes as one slice cut into strides: no bounds check per element,
-        // and contiguous little-endian data compiles to little more than a copy.
-        let convert = |bytes: &[u8]| {
-            let mut $a: [u8; $n] = bytes[..$n].try_into().expect("an element's bytes");
-            if $e == Endian::Big {
-                $a.reverse();
-            }
-            $conv
-        };
-        match $count {
-            0 => {}
-            count if $stride == $n => $out.extend(
-                $data[$start..$start + count * $n]
-                    .chunks_exact($n)
-                    .map(convert),
-            ),
-            count if $stride > $n => $out.extend(
-                $data[$start..$start + (count - 1) * $stride + $n]
-                    .chunks($stride)
-                    .map(convert),
-            ),
-            count => $out.extend((0..count).map(|i| {
-                let o = $start + i * $stride;
-                convert(&$data[o..o + $n])
-            })),
+/// Decodes `count` elements of `N` bytes, the first at `data[start]`, one every `stride`
+/// bytes, by `conv` of their bytes in little-endian order, onto the end of `out`. One small
+/// function per element type (rather than one large match around the loops), so that the
+/// compiler inlines `Vec::extend` into each and the loop stays a tight one whatever else
+/// the crate holds: the elements' bytes as one slice cut into strides, no bounds check per
+/// element, and contiguous little-endian data compiles to little more than a copy.
+#[inline(never)]
+fn decode<const N: usize, T>(
+    data: &[u8],
+    start: usize,
+    count: usize,
+    stride: usize,
+    e: Endian,
+    out: &mut Vec<T>,
+    conv: impl Fn([u8; N]) -> T,
+) {
+    let convert = |bytes: &[u8]| {
+        let mut a: [u8; N] = bytes[..N].try_into().expect("an element's bytes");
+        if e == Endian::Big {
+            a.reverse();
         }
-    }};
+        conv(a)
+    };
+    match count {
+        0 => {}
+        count if stride == N => {
+            out.extend(data[start..start + count * N].chunks_exact(N).map(convert))
+        }
+        count if stride > N => out.extend(
+            data[start..start + (count - 1) * stride + N]
+                .chunks(stride)
+                .map(convert),
+        ),
+        count => out.extend((0..count).map(|i| {
+            let o = start + i * stride;
+            convert(&data[o..o + N])
+        })),
+    }
 }
 
 /// Decodes `count` elements of type `t`, the first at `data[start]`, one every `stride`
@@ -116,35 +125,24 @@ fn gather(
     out: &mut Vec<f64>,
 ) -> Result<(), Inexact> {
     out.reserve(count);
+    let (d, s, c) = (data, start, count);
     match t {
-        Dtype::I8 => gather!(data, start, count, stride, 1, e, out, |a| a[0] as i8 as f64),
-        Dtype::U8 => gather!(data, start, count, stride, 1, e, out, |a| a[0] as f64),
-        Dtype::I16 => gather!(data, start, count, stride, 2, e, out, |a| {
-            i16::from_le_bytes(a) as f64
-        }),
-        Dtype::U16 => gather!(data, start, count, stride, 2, e, out, |a| {
-            u16::from_le_bytes(a) as f64
-        }),
-        Dtype::I32 => gather!(data, start, count, stride, 4, e, out, |a| {
-            i32::from_le_bytes(a) as f64
-        }),
-        Dtype::U32 => gather!(data, start, count, stride, 4, e, out, |a| {
-            u32::from_le_bytes(a) as f64
-        }),
-        Dtype::F32 => gather!(data, start, count, stride, 4, e, out, |a| {
-            f32::from_le_bytes(a) as f64
-        }),
-        Dtype::F64 => gather!(data, start, count, stride, 8, e, out, |a| {
-            f64::from_le_bytes(a)
-        }),
+        Dtype::I8 => decode(d, s, c, stride, e, out, |a: [u8; 1]| a[0] as i8 as f64),
+        Dtype::U8 => decode(d, s, c, stride, e, out, |a: [u8; 1]| a[0] as f64),
+        Dtype::I16 => decode(d, s, c, stride, e, out, |a| i16::from_le_bytes(a) as f64),
+        Dtype::U16 => decode(d, s, c, stride, e, out, |a| u16::from_le_bytes(a) as f64),
+        Dtype::I32 => decode(d, s, c, stride, e, out, |a| i32::from_le_bytes(a) as f64),
+        Dtype::U32 => decode(d, s, c, stride, e, out, |a| u32::from_le_bytes(a) as f64),
+        Dtype::F32 => decode(d, s, c, stride, e, out, |a| f32::from_le_bytes(a) as f64),
+        Dtype::F64 => decode(d, s, c, stride, e, out, f64::from_le_bytes),
         Dtype::I64 | Dtype::U64 => {
-            let mut wide = Vec::with_capacity(count);
+            let mut wide: Vec<i128> = Vec::with_capacity(count);
             if t == Dtype::I64 {
-                gather!(data, start, count, stride, 8, e, wide, |a| {
+                decode(d, s, c, stride, e, &mut wide, |a| {
                     i64::from_le_bytes(a) as i128
                 });
             } else {
-                gather!(data, start, count, stride, 8, e, wide, |a| {
+                decode(d, s, c, stride, e, &mut wide, |a| {
                     u64::from_le_bytes(a) as i128
                 });
             }
