@@ -1,7 +1,7 @@
 //! `rotorid`: simulate rotor-bearing vibration and identify its physical parameters.
 //!
 //! A thin entry point: parse the command line, run one command, and print any error as
-//! `Error: {:#}` with a non-zero exit code.
+//! `Error: ` and its causes, each once ([`io::message`]), with a non-zero exit code.
 
 use clap::{Parser, Subcommand};
 
@@ -86,7 +86,7 @@ fn main() {
             // the reader of our output went away (`| head`): nothing more to say
             std::process::exit(0);
         }
-        eprintln!("Error: {err:#}");
+        eprintln!("Error: {}", io::message::error_message(&err));
         std::process::exit(1);
     }
 }

@@ -20,6 +20,7 @@ pub use rotorid_io::csv::{columns, error as csv_error, lines, number};
 
 pub mod estimates_csv;
 pub mod identified;
+pub mod message;
 pub mod output;
 pub mod params;
 pub mod progress;

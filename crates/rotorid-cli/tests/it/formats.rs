@@ -505,3 +505,19 @@ fn a_panic_of_the_parquet_crate_is_an_error_without_a_panic_message() {
         assert!(!stderr.contains("panicked"), "{command}: {stderr}");
     }
 }
+
+#[test]
+fn an_error_says_its_cause_once() {
+    // The readers' errors carry their cause in their message and as their source: printed
+    // once, not once per link of the chain.
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.tdms");
+    let out = rotorid()
+        .args(["inspect", missing.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("missing.tdms: "), "{stderr}");
+    assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
+}
