@@ -172,7 +172,7 @@ pub enum UnitError {
         expected: Quantity,
     },
     /// The unit is known but measures something else.
-    #[error("unit {unit:?} is {} {found} unit, but this channel holds {} {expected}: use one of {accepted}", found.article(), expected.article(), accepted = expected.accepted())]
+    #[error("unit {unit:?} is {} {found} unit, but this channel holds {} {expected}: use one of {accepted}{hint}", found.article(), expected.article(), accepted = expected.accepted(), hint = hint(*found, *expected))]
     WrongQuantity {
         /// The unit as written.
         unit: String,
@@ -181,6 +181,19 @@ pub enum UnitError {
         /// The quantity the channel's role needs.
         expected: Quantity,
     },
+}
+
+/// What to do about a channel of `found` where `expected` is needed, when there is more to
+/// say than the units to use.
+fn hint(found: Quantity, expected: Quantity) -> &'static str {
+    match (found, expected) {
+        (Quantity::Voltage, Quantity::Displacement) => {
+            " (a proximity probe's volts become a displacement through the scenario's \
+             [acquisition] table: each probe's column, angle and sensitivity, and the \
+             keyphasor; docs/acquisition.md)"
+        }
+        _ => "",
+    }
 }
 
 /// Every unit we know: spelling (normalised, see [`normalise_unit`]), canonical spelling,
@@ -407,6 +420,17 @@ mod tests {
             }
         ));
         assert!(e.to_string().contains("rpm"), "{e}");
+        assert!(!e.to_string().contains("[acquisition]"), "{e}");
+        // a probe's volts (as DAQmx names them) where metres are needed: the way to them
+        let e = conversion(Quantity::Displacement, Some("Volts")).unwrap_err();
+        assert!(
+            e.to_string().starts_with(
+                "unit \"Volts\" is a voltage unit, but this channel holds a displacement: use \
+                 one of m, mm, um (µm), nm, mil, in (a proximity probe's volts become a \
+                 displacement through the scenario's [acquisition] table"
+            ),
+            "{e}"
+        );
         // rad/s is a speed, not an angle.
         assert!(conversion(Quantity::Angle, Some("rad/s")).is_err());
     }
