@@ -23,12 +23,11 @@ macro_rules! out {
     }};
 }
 
-mod alloc;
 mod commands;
 mod io;
 
 #[global_allocator]
-static ALLOCATOR: alloc::HugePageAdvice = alloc::HugePageAdvice;
+static ALLOCATOR: rotorid_alloc::HugePageAdvice = rotorid_alloc::HugePageAdvice;
 mod plot;
 mod report;
 

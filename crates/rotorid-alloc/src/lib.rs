@@ -1,6 +1,9 @@
-//! The binary's allocator: the system's, with every block of [`THRESHOLD`] bytes or more
-//! offered to the kernel for transparent huge pages (`madvise(MADV_HUGEPAGE)` on the 2 MiB
-//! pages the block covers).
+//! The allocator of the `rotorid` binary and of the Python extension (each declares it as
+//! its `#[global_allocator]`): the system's, with every block of [`THRESHOLD`] bytes or
+//! more offered to the kernel for transparent huge pages (`madvise(MADV_HUGEPAGE)` on the
+//! 2 MiB pages the block covers). In the Python extension it serves the extension's own
+//! allocations (the channels a reader fills, which numpy then owns and frees through it),
+//! not Python's.
 //!
 //! Why: a binary recording's channels are tens of megabytes written once. With 4 KiB pages
 //! each page costs a fault on first touch, and on the 2-core test machine those faults were
