@@ -7,7 +7,7 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use rotorid::acquisition::{
-    condition, Acquisition, Conditioned, GuessSource, ModelGuess, RawRecord,
+    condition, Acquisition, Conditioned, GuessSource, ModelGuess, RawRecord, TimeBase,
 };
 use rotorid::pipeline::{identify, Knowledge, Method, Record};
 use rotorid::scenario_file::ScenarioSpec;
@@ -62,23 +62,54 @@ pub fn columns(table: &Table, columns: Option<&str>) -> anyhow::Result<SiColumns
 }
 
 /// The raw record of `table` for `acq`: every channel by name, the ones `acq` uses in SI
-/// (time in s, probes and keyphasor in V, from their units).
+/// (time in s, probes and keyphasor in V, from their units). An acquisition column names
+/// a channel as `--columns` does: exactly, else by its short name when that is unique
+/// (`probe_L` for a TDMS `rig/probe_L`); the channel then goes by the acquisition's name.
+/// Without a time channel, a file's time axis (TDMS `wf_increment`, a UFF58 abscissa) on
+/// the first probe gives it, t_i = start + i increment, with a note on stderr.
 pub fn raw_record(table: &Table, acq: &Acquisition) -> anyhow::Result<RawRecord> {
-    let mut columns = Vec::with_capacity(table.channels.len());
+    let roles: Vec<(&str, &str, Option<&str>)> = acq
+        .columns()
+        .into_iter()
+        .map(|(n, what)| (n, what, table.channel(n).map(|c| c.name.as_str())))
+        .collect();
+    let mut columns = Vec::with_capacity(table.channels.len() + 1);
     for c in &table.channels {
-        let role = acq.columns().into_iter().find(|(n, _)| *n == c.name);
+        let role = roles
+            .iter()
+            .find(|(_, _, found)| *found == Some(c.name.as_str()));
         let mut data = c.data.clone();
-        if let Some((_, what)) = role {
-            let q = if what == "time" {
-                Quantity::Time
-            } else {
-                Quantity::Voltage
-            };
-            let conv = conversion(q, c.unit.as_deref())
-                .with_context(|| format!("{}, channel {:?} ({what})", table.file, c.name))?;
-            conv.apply_all(&mut data);
+        let name = match role {
+            Some(&(name, what, _)) => {
+                let q = if what == "time" {
+                    Quantity::Time
+                } else {
+                    Quantity::Voltage
+                };
+                let conv = conversion(q, c.unit.as_deref())
+                    .with_context(|| format!("{}, channel {:?} ({what})", table.file, c.name))?;
+                conv.apply_all(&mut data);
+                name.to_string()
+            }
+            None => c.name.clone(),
+        };
+        columns.push((name, data));
+    }
+    if let TimeBase::Column(t) = &acq.time {
+        let probe = table.channel(&acq.probes[0].column);
+        if let (None, Some(axis), Some(probe)) =
+            (table.channel(t), probe.and_then(|p| p.axis), probe)
+        {
+            eprintln!(
+                "note: {}: time from the file's time axis of {:?} (no channel {t:?})",
+                table.file, probe.name
+            );
+            let n = probe.data.len();
+            let times = (0..n)
+                .map(|i| axis.start + i as f64 * axis.increment)
+                .collect();
+            columns.push((t.clone(), times));
         }
-        columns.push((c.name.clone(), data));
     }
     Ok(RawRecord { columns })
 }
@@ -126,7 +157,16 @@ pub fn condition_for(
     let id = identify(&rec, knowledge, method)?;
     match ModelGuess::from_identification(&id, knowledge) {
         Some(g) => Ok(condition(raw, acq, slow, Some(&g))?),
-        None => Ok(first),
+        None => {
+            let mut first = first;
+            first.report.notes.push(
+                "the first pass's estimates do not make a rotor the model accepts (m, kx, kz \
+                 > 0) and the scenario has no nominal values to stand in: the record stays \
+                 conditioned without that guess"
+                    .into(),
+            );
+            Ok(first)
+        }
     }
 }
 

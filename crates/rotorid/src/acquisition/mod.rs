@@ -45,7 +45,7 @@ pub use model_fit::ModelFit;
 pub use raw::{simulate_raw, RawSettings, RawSimulation, RunoutHarmonic};
 pub use runout::Harmonics;
 
-use crate::model::{check, InitialState, RotorParams};
+use crate::model::{check, InitialState, Rotor, RotorParams};
 use crate::parameter::Parameter;
 use crate::pipeline::{Identification, Knowledge};
 
@@ -272,34 +272,45 @@ pub struct ModelGuess {
 impl ModelGuess {
     /// The guess from an identification: each refined or identified parameter's estimate
     /// (refine: m; algebraic/modulating: the mean of m_x and m_z) over `known` (a, the
-    /// unbalance, nominal values), and refine's fitted initial state. `None` when m, cx,
-    /// kx, cz or kz has neither an estimate nor a nominal value.
+    /// unbalance, nominal values), and refine's fitted initial state. An estimate outside
+    /// the model's range (m, kx or kz not > 0, an unbalance not >= 0: an algebraic estimate
+    /// on a record that cannot determine it, say) is not used: the nominal value stands
+    /// in. `None` when m, cx, kx, cz or kz then has neither, or the rotor is still not one
+    /// [`Rotor::new`] accepts.
     pub fn from_identification(id: &Identification, known: &Knowledge) -> Option<Self> {
         let est = |p: Parameter| id.parameter(p).and_then(|r| r.estimate.or(r.value));
+        let positive = |v: &f64| v.is_finite() && *v > 0.0;
         let nominal = |p: Parameter| known.nominal.get(p);
         let m = est(Parameter::M)
             .or_else(|| Some(0.5 * (est(Parameter::MX)? + est(Parameter::MZ)?)))
+            .filter(positive)
             .or_else(|| nominal(Parameter::M))?;
-        let get = |p: Parameter| est(p).or_else(|| nominal(p));
+        let get = |p: Parameter| est(p).filter(|v| v.is_finite()).or_else(|| nominal(p));
+        let stiffness = |p: Parameter| est(p).filter(positive).or_else(|| nominal(p));
         let mut unbalance = known.unbalance;
         if let (Some(mud), Some(alpha)) = (est(Parameter::Mud), est(Parameter::Alpha)) {
-            unbalance.alpha = alpha;
-            if unbalance.d > 0.0 {
-                unbalance.m_u = mud / unbalance.d;
-            } else {
-                unbalance.m_u = mud;
-                unbalance.d = 1.0;
+            if mud.is_finite() && mud >= 0.0 && alpha.is_finite() {
+                unbalance.alpha = alpha;
+                if unbalance.d > 0.0 {
+                    unbalance.m_u = mud / unbalance.d;
+                } else {
+                    unbalance.m_u = mud;
+                    unbalance.d = 1.0;
+                }
             }
         }
         let rotor = RotorParams {
             m,
             cx: get(Parameter::Cx)?.max(0.0),
-            kx: get(Parameter::Kx)?,
+            kx: stiffness(Parameter::Kx)?,
             cz: get(Parameter::Cz)?.max(0.0),
-            kz: get(Parameter::Kz)?,
-            a: est(Parameter::A).unwrap_or(known.a),
+            kz: stiffness(Parameter::Kz)?,
+            a: est(Parameter::A)
+                .filter(|v| v.is_finite())
+                .unwrap_or(known.a),
             unbalance,
         };
+        Rotor::new(rotor).ok()?;
         let initial = id.refine.as_ref().and_then(|r| {
             let v = |n: &str| {
                 r.initial_state
