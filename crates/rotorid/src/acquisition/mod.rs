@@ -386,15 +386,17 @@ impl AcquisitionFinding {
                         )
                     })
                     .collect();
-                let what = if *slow_roll_given {
-                    "the slow-roll runout compensation left"
+                if *slow_roll_given {
+                    format!(
+                        "the slow-roll runout compensation left content locked to the shaft angle that the model does not explain ({}): the slow-roll record may not be of this machine and these probes, or the rotor guess (the scenario's, or the first identification's) is far from the truth; either biases m, c, k",
+                        list.join(", ")
+                    )
                 } else {
-                    "without [acquisition.runout] the conditioned record holds"
-                };
-                format!(
-                    "{what} content locked to the shaft angle that the model does not explain ({}): probe runout biases m, c, k; give a slow-roll record in [acquisition.runout]",
-                    list.join(", ")
-                )
+                    format!(
+                        "without [acquisition.runout] the conditioned record holds content locked to the shaft angle that the model does not explain ({}): probe runout biases m, c, k; give a slow-roll record in [acquisition.runout]",
+                        list.join(", ")
+                    )
+                }
             }
             Self::KeyphasorRepaired {
                 missed_before_s,

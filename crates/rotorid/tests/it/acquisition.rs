@@ -239,6 +239,29 @@ fn runout_left_in_is_found_and_absent_runout_is_not() {
     // With the slow-roll record, or on data without runout, nothing is found.
     let c = condition(&raw.running, &acq, raw.slow_roll.as_ref(), Some(&guess(&s))).unwrap();
     assert!(c.report.findings.is_empty(), "{:?}", c.report.findings);
+    // With the slow-roll record and a rotor guess far from the truth (stiffness halved),
+    // what is left is found, and the advice is not to give the slow-roll record it has.
+    let mut far = guess(&s);
+    far.rotor.kx *= 0.5;
+    far.rotor.kz *= 0.5;
+    let c = condition(&raw.running, &acq, raw.slow_roll.as_ref(), Some(&far)).unwrap();
+    let msg = c
+        .report
+        .findings
+        .iter()
+        .find(|f| {
+            matches!(
+                f,
+                AcquisitionFinding::ResidualRunout {
+                    slow_roll_given: true,
+                    ..
+                }
+            )
+        })
+        .map(AcquisitionFinding::message)
+        .expect("residual content found with a wrong guess");
+    assert!(msg.contains("rotor guess"), "{msg}");
+    assert!(!msg.contains("give a slow-roll record"), "{msg}");
     let mut clean = Acquisition::example();
     clean.simulate.runout = [vec![], vec![]];
     let raw = raw_of(&s, &clean);
