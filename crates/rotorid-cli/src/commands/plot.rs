@@ -9,7 +9,8 @@
 //! - an estimates column (`m_x` ... `k_z`, `rcond_x`, `rcond_z`): identify output
 //!   (`t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z`) -> three stacked panels m, c, k against
 //!   time, both directions solid; with `--scenario`, the true values dashed. Ill-conditioned
-//!   instants are empty in that file and show as gaps. y is scaled to what is visible and
+//!   instants are empty in that file and show as gaps, and so do restarts (a change of
+//!   `window`: the lines of two windows are not joined). y is scaled to what is visible and
 //!   kept within +-50 % of a reference: the true value, else the median of the last quarter
 //!   of the window's estimates.
 //! - otherwise `t` with `x` or `z`: simulate output (`t,x,z[,phi,phi_dot,phi_ddot]`) ->
@@ -505,10 +506,19 @@ fn read_estimates<R: Read>(name: &str, input: R, window: Window) -> anyhow::Resu
         curves: vec![ColumnThinner::new(COLUMNS, window); 6],
         late: vec![Subsample::new(MEDIAN_VALUES); 6],
     };
+    let mut last_window = None;
     while let Some(row) = r.next_row()? {
         let before = d.extent.inside;
         d.extent.push(row.t, window);
         let inside = d.extent.inside > before;
+        // a restart (--restart): the estimates of the new window are not joined to the
+        // last of the old one
+        if row.window.is_some() && last_window.is_some() && row.window != last_window {
+            for c in &mut d.curves {
+                c.push(row.t, f64::NAN);
+            }
+        }
+        last_window = row.window;
         for (i, v) in row.values.to_array().into_iter().enumerate() {
             let v = v.unwrap_or(f64::NAN);
             d.curves[i].push(row.t, v);
@@ -727,6 +737,26 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("empty"));
+    }
+
+    #[test]
+    fn a_restart_breaks_the_lines_between_windows() {
+        let h = crate::io::ESTIMATES_HEADER.join(",");
+        let text = format!(
+            "{h}\n0.1,1,2,3,4,5,6,0.5,0.5,0\n0.2,1,2,3,4,5,6,0.5,0.5,0\n\
+             0.3,9,9,9,9,9,9,0.5,0.5,1\n0.4,9,9,9,9,9,9,0.5,0.5,1\n"
+        );
+        let d = read_estimates("e.csv", text.as_bytes(), Window::default()).unwrap();
+        for c in &d.curves {
+            let (x, y) = c.points();
+            assert_eq!(x.len(), 5, "{x:?}");
+            assert!(y[2].is_nan() && x[1] == 0.2 && x[3] == 0.3, "{x:?} {y:?}");
+        }
+        // without the column (an older file), or within one window: no break
+        let old = "t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z\n0.1,1,2,3,4,5,6,0.5,0.5\n\
+                   0.2,9,9,9,9,9,9,0.5,0.5\n";
+        let d = read_estimates("e.csv", old.as_bytes(), Window::default()).unwrap();
+        assert!(d.curves[0].points().1.iter().all(|v| v.is_finite()));
     }
 
     #[test]
