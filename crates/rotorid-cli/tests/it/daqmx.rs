@@ -11,7 +11,7 @@
 
 use std::path::Path;
 
-use crate::common::{data, rotorid};
+use crate::common::{data, first_four_columns, rotorid};
 
 fn run(args: &[&str]) {
     let out = rotorid().args(args).output().unwrap();
@@ -72,14 +72,7 @@ fn channel(
 /// the time is not a channel but the waveform properties of the others (`wf_increment`
 /// `dt`, `wf_start_offset` 0), as a logging task writes them.
 fn write_daqmx(csv: &str, out: &Path, per: usize, dt: Option<f64>) {
-    let rows: Vec<[f64; 4]> = csv
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|f| f.parse().unwrap()).collect();
-            [v[0], v[1], v[2], v[3]]
-        })
-        .collect();
+    let rows = first_four_columns(csv);
     let q = 24.0 / 65536.0;
     let code = |v: f64| -> i16 {
         let k = (v + 24.0) / q;

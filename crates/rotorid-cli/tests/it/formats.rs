@@ -9,7 +9,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use crate::common::{data, rotorid};
+use crate::common::{data, first_four_columns, rotorid};
 
 fn run(args: &[&str]) -> (String, String) {
     let out = rotorid().args(args).output().unwrap();
@@ -382,14 +382,7 @@ fn a_raw_acquisition_is_conditioned_and_identified() {
     // the test finds phi passing 0 (mod 2 pi) in the conditioned CSV, x and z interpolated
     // linearly, up to the plot's map from metres to pixels (equal scales, y downwards)
     let dots = &orbits[0][..orbits[0].len() - 1];
-    let rows: Vec<[f64; 4]> = text
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|f| f.parse().unwrap()).collect();
-            [v[0], v[1], v[2], v[3]]
-        })
-        .collect();
+    let rows = first_four_columns(&text);
     let tau = std::f64::consts::TAU;
     let expected: Vec<(f64, f64)> = rows
         .windows(2)

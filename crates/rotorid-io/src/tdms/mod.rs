@@ -577,27 +577,13 @@ fn raw_data<S: Source + ?Sized>(
         return daqmx_data(src, r, &c, &present, objects);
     }
     let region = r.end - r.start;
-    let Some(chunk) = present
+    let chunk = present
         .iter()
-        .try_fold(0u64, |a, (_, i)| a.checked_add(i.bytes))
+        .try_fold(0u64, |a, (_, i)| a.checked_add(i.bytes));
+    let Some((chunk, chunks)) = chunk_count(&c, region, chunk, "chunk its object list describes")?
     else {
-        return Err(c.invalid(
-            "TDMS chunk size",
-            "beyond 64 bits",
-            format!("at most the raw data's {region} bytes"),
-        ));
-    };
-    if chunk == 0 || region == 0 {
         return Ok(());
-    }
-    if !region.is_multiple_of(chunk) {
-        return Err(c.invalid(
-            "TDMS raw data size",
-            format!("{region} bytes"),
-            format!("a multiple of the {chunk}-byte chunk its object list describes"),
-        ));
-    }
-    let chunks = region / chunk;
+    };
     if interleaved {
         return interleaved_data(src, r, &c, &present, chunk, chunks, objects);
     }
@@ -631,6 +617,35 @@ fn raw_data<S: Source + ?Sized>(
         }
     }
     Ok(())
+}
+
+/// The chunk size and count of `region` bytes of raw data in chunks of `chunk` bytes
+/// (`None`: beyond 64 bits), `layout` saying what lays them out; `Ok(None)` when there is
+/// nothing to read, an error unless the chunks divide the region.
+fn chunk_count(
+    c: &Cursor,
+    region: u64,
+    chunk: Option<u64>,
+    layout: &str,
+) -> Result<Option<(u64, u64)>, ReadError> {
+    let Some(chunk) = chunk else {
+        return Err(c.invalid(
+            "TDMS chunk size",
+            "beyond 64 bits",
+            format!("at most the raw data's {region} bytes"),
+        ));
+    };
+    if chunk == 0 || region == 0 {
+        return Ok(None);
+    }
+    if !region.is_multiple_of(chunk) {
+        return Err(c.invalid(
+            "TDMS raw data size",
+            format!("{region} bytes"),
+            format!("a multiple of the {chunk}-byte {layout}"),
+        ));
+    }
+    Ok(Some((chunk, region / chunk)))
 }
 
 /// DAQmx raw data ([`daqmx`]): each chunk is the raw buffers in turn, rows of their width;
@@ -701,26 +716,14 @@ fn daqmx_data<S: Source + ?Sized>(
     let chunk = rows.iter().zip(&widths).try_fold(0u64, |a, (&n, &w)| {
         a.checked_add(n.checked_mul(u64::from(w))?)
     });
-    let Some(chunk) = chunk.filter(|&n| n <= region || region == 0) else {
-        return Err(c.invalid(
-            "TDMS DAQmx chunk size",
-            format!("more than the raw data's {region} bytes"),
-            format!("at most {region} bytes"),
-        ));
-    };
-    if chunk == 0 || region == 0 {
+    let Some((chunk, chunks)) =
+        chunk_count(c, region, chunk, "DAQmx chunk its raw buffers describe")?
+    else {
         return Ok(());
-    }
-    if !region.is_multiple_of(chunk) {
-        return Err(c.invalid(
-            "TDMS raw data size",
-            format!("{region} bytes"),
-            format!("a multiple of the {chunk}-byte DAQmx chunk its raw buffers describe"),
-        ));
-    }
+    };
     let names: Vec<String> = present.iter().map(|&(k, _)| objects[k].name()).collect();
     let mut scratch = Vec::new();
-    for n in 0..region / chunk {
+    for n in 0..chunks {
         let mut base = r.start + n * chunk;
         for (b, (&count, &width)) in rows.iter().zip(&widths).enumerate() {
             let width = u64::from(width);

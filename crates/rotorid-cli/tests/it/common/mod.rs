@@ -80,3 +80,14 @@ pub fn state<'a>(summary: &'a Value, name: &str) -> &'a Value {
         .and_then(|a| a.iter().find(|p| p["name"] == name))
         .unwrap_or(&Value::Null)
 }
+
+/// The first four columns of every data row of CSV `text` (after its header), as numbers.
+pub fn first_four_columns(text: &str) -> Vec<[f64; 4]> {
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').take(4).map(|f| f.parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3]]
+        })
+        .collect()
+}
