@@ -17,7 +17,7 @@
 //! most 1032 times that plus 1 KiB, since the `parquet` crate allocates a page's claimed
 //! uncompressed size before decompressing. Errors of the `parquet` crate are reported as
 //! [`ReadError::Container`] with its message. Each column chunk is decoded under its own
-//! guard ([`crate::guard`]): should the crate panic on a malformed page, the error names
+//! guard (`crate::guard`): should the crate panic on a malformed page, the error names
 //! the column, the row group and the chunk's byte offset, as a null or an inexact integer
 //! does.
 

@@ -21,8 +21,8 @@
 //! `wf_increment` \[s\] when the latter is present. Numeric types (`i8`..`u64`, `f32`,
 //! `f64`, and their "with unit" variants) are read; string, boolean, timestamp, complex and
 //! extended-float channels are skipped (their bytes are stepped over). DAQmx raw data, as
-//! NI-DAQmx logs it, is read ([`daqmx`]), and values stored unscaled are scaled by the
-//! channel's `NI_Scale` properties, as npTDMS does ([`scaling`]; a scale type rotorid does
+//! NI-DAQmx logs it, is read (`tdms/daqmx.rs`), and values stored unscaled are scaled by the
+//! channel's `NI_Scale` properties, as npTDMS does (`tdms/scaling.rs`; a scale type rotorid does
 //! not apply is refused, never returned unscaled). A truncated segment, a chunk that does
 //! not divide the raw data, or interleaved channels of unequal counts are errors naming
 //! the byte offset.
