@@ -44,6 +44,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
     Ok(Table {
         file: file.to_string(),
         channels,
+        notes: Vec::new(),
     })
 }
 

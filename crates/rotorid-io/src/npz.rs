@@ -149,5 +149,6 @@ fn read_from<R: Read + std::io::Seek, S: Source + ?Sized>(
     Ok(Table {
         file: file.to_string(),
         channels,
+        notes: Vec::new(),
     })
 }

@@ -193,6 +193,7 @@ fn read_inner<R: ChunkReader + 'static>(
     Ok(Table {
         file: file.to_string(),
         channels,
+        notes: Vec::new(),
     })
 }
 

@@ -338,6 +338,7 @@ mod tests {
         Table {
             file: "rec.mat".into(),
             channels,
+            notes: Vec::new(),
         }
     }
 

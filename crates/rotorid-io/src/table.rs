@@ -33,6 +33,10 @@ pub struct Table {
     pub file: String,
     /// The channels, in file order.
     pub channels: Vec<Channel>,
+    /// What the reader has to tell about the file that is not an error (a recording
+    /// interrupted mid-segment, whose unfinished chunk was not read): one sentence each,
+    /// for the caller to show.
+    pub notes: Vec<String>,
 }
 
 impl Table {
@@ -84,6 +88,7 @@ mod tests {
         let t = Table {
             file: "f".into(),
             channels: vec![ch("rec.x"), ch("rec.z"), ch("g1/z"), ch("t")],
+            notes: Vec::new(),
         };
         assert_eq!(t.channel("rec.x").unwrap().name, "rec.x");
         assert_eq!(t.channel("x").unwrap().name, "rec.x");

@@ -260,6 +260,7 @@ fn read_from<R: BufRead>(file: &str, input: R, size: u64) -> Result<Table, ReadE
     Ok(Table {
         file: file.to_string(),
         channels,
+        notes: Vec::new(),
     })
 }
 

@@ -42,6 +42,7 @@ fn table(n: usize) -> Table {
             ch("rec.z", z),
             ch("rec.speed", speed),
         ],
+        notes: Vec::new(),
     }
 }
 
@@ -106,6 +107,7 @@ fn unequal_lengths_and_bad_names_are_refused_where_the_format_cannot_hold_them()
     let t = Table {
         file: "f".into(),
         channels: vec![ch("g/x", vec![1.0])],
+        notes: Vec::new(),
     };
     let e = mat_v5_bytes("a.mat", &t).unwrap_err();
     assert!(e.to_string().contains("not a MATLAB identifier"), "{e}");
@@ -118,6 +120,7 @@ fn empty_channels_round_trip() {
     let t = Table {
         file: "f".into(),
         channels: vec![ch("a", vec![]), ch("b", vec![])],
+        notes: Vec::new(),
     };
     let dir = tempfile::tempdir().unwrap();
     for ext in ["npz", "parquet"] {

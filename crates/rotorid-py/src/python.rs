@@ -356,6 +356,16 @@ fn read(
     for (name, unit) in r.converted {
         units.set_item(name, unit)?;
     }
+    // what the reader noted (an interrupted recording's unfinished chunk) as a warning
+    for n in &r.notes {
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        PyErr::warn(
+            py,
+            &category,
+            &std::ffi::CString::new(format!("{path}: {n}"))?,
+            1,
+        )?;
+    }
     Ok((d, units))
 }
 

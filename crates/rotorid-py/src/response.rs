@@ -25,6 +25,9 @@ pub struct Response {
     /// "um")`), in the order t, x, z, phi, phi_dot, phi_ddot: their values above are
     /// converted to SI.
     pub converted: Vec<(String, String)>,
+    /// What the reader noted about the file that is not an error (an interrupted TDMS
+    /// recording whose unfinished chunk was not read), one sentence each.
+    pub notes: Vec<String>,
 }
 
 /// Read the response CSV at `path` (module doc).
@@ -53,6 +56,7 @@ pub fn read_any(path: &str, columns: Option<&str>) -> Result<Response, Error> {
     };
     let s = rotorid_io::select(&table, &map)?;
     Ok(Response {
+        notes: table.notes.clone(),
         converted: s
             .used
             .iter()
@@ -81,6 +85,7 @@ pub fn parse<R: Read>(file: &str, input: R) -> Result<Response, Error> {
         z: c.z,
         speed: c.speed,
         converted,
+        notes: Vec::new(),
     })
 }
 

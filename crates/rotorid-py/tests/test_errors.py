@@ -171,3 +171,28 @@ def test_read_converts_units_to_si_and_says_which(tmp_path):
                                          r"for a displacement: use one of m, mm, um"):
         other.write_text("t,x [furlong],z\n0,0,0\n")
         rotorid.read(other)
+
+
+def test_an_interrupted_tdms_recording_is_read_with_a_warning(tmp_path):
+    """A TDMS segment its writer left open (next offset all ones), its raw data cut short:
+    the whole chunks are read and a warning says what was not."""
+    import struct
+
+    def text(v: str) -> bytes:
+        return struct.pack("<I", len(v)) + v.encode()
+
+    names = ["t", "x", "z"]
+    meta = struct.pack("<I", len(names))
+    for n in names:  # f64 channels of 4 values per chunk, no properties
+        meta += text(f"/'g'/'{n}'") + struct.pack("<IIIQI", 20, 10, 1, 4, 0)
+    chunk = lambda k: b"".join(
+        struct.pack("<4d", *[(10 * k + i) * 1e-4 for i in range(4)]) for _ in names
+    )
+    raw = chunk(0) + chunk(1)[:-3]
+    lead = b"TDSm" + struct.pack("<IIQQ", 0x2 | 0x4 | 0x8, 4713, 2**64 - 1, len(meta))
+    path = tmp_path / "cut.tdms"
+    path.write_bytes(lead + meta + raw)
+    with pytest.warns(UserWarning, match=r"cut\.tdms: .*interrupted recording.* were not read"):
+        df = rotorid.read(path)
+    assert len(df) == 4
+    np.testing.assert_array_equal(df["x"], [i * 1e-4 for i in range(4)])

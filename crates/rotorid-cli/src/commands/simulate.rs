@@ -168,6 +168,7 @@ fn response_table(file: &str, r: TimeResponse) -> rotorid_io::Table {
     let data = [r.t, r.x, r.z, r.phi, r.phi_dot, r.phi_ddot];
     rotorid_io::Table {
         file: file.to_owned(),
+        notes: Vec::new(),
         channels: ["t", "x", "z", "phi", "phi_dot", "phi_ddot"]
             .into_iter()
             .zip(data)
@@ -215,6 +216,7 @@ fn write_table_file(
 fn raw_table(file: &str, raw: rotorid::acquisition::RawRecord) -> rotorid_io::Table {
     rotorid_io::Table {
         file: file.to_owned(),
+        notes: Vec::new(),
         channels: raw
             .columns
             .into_iter()

@@ -28,9 +28,14 @@ pub fn is_tabular(input: &str, columns: Option<&str>) -> bool {
     regular && (!csv || columns.is_some())
 }
 
-/// The table of the file at `path` (its format from its extension).
+/// The table of the file at `path` (its format from its extension); what the reader noted
+/// about the file (an interrupted recording's unfinished chunk) as `note:` lines on stderr.
 pub fn read(path: &str) -> anyhow::Result<Table> {
-    Ok(rotorid_io::read_table(path)?)
+    let table = rotorid_io::read_table(path)?;
+    for n in &table.notes {
+        eprintln!("note: {}: {n}", table.file);
+    }
+    Ok(table)
 }
 
 /// The channels of `table` that play t, x, z and (when present) phi, phi_dot, phi_ddot, in

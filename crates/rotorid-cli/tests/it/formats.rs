@@ -514,3 +514,34 @@ fn an_error_says_its_cause_once() {
     assert!(stderr.contains("missing.tdms: "), "{stderr}");
     assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
 }
+
+#[test]
+fn an_interrupted_tdms_recording_is_read_up_to_its_last_whole_chunk_with_a_note() {
+    // npTDMS's rec.tdms as a writer leaves it when the recording stops mid-segment: the last
+    // segment's next offset all ones, its raw data cut short
+    let mut f = std::fs::read(format!(
+        "{}/../rotorid-io/fixtures/rec.tdms",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let mut seg = 0;
+    loop {
+        let next = u64::from_le_bytes(f[seg + 12..seg + 20].try_into().unwrap()) as usize;
+        if seg + 28 + next == f.len() {
+            break;
+        }
+        seg += 28 + next;
+    }
+    f[seg + 12..seg + 20].copy_from_slice(&u64::MAX.to_le_bytes());
+    f.truncate(f.len() - 3);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cut.tdms");
+    std::fs::write(&path, &f).unwrap();
+    let (out, err) = run(&["inspect", path.to_str().unwrap()]);
+    assert!(out.contains("channel"), "{out}");
+    assert!(
+        err.contains("cut.tdms: the segment whose raw data starts at byte")
+            && err.contains("was left open by its writer (an interrupted recording)"),
+        "{err}"
+    );
+}

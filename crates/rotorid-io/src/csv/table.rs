@@ -105,6 +105,7 @@ fn read<R: Read>(file: &str, input: R, fast: bool) -> Result<Table, CsvError> {
     Ok(Table {
         file: file.to_owned(),
         channels,
+        notes: Vec::new(),
     })
 }
 

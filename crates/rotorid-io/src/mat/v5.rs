@@ -185,6 +185,7 @@ fn finish(file: &str, channels: Vec<Channel>, skipped: Vec<String>) -> Result<Ta
     Ok(Table {
         file: file.to_string(),
         channels,
+        notes: Vec::new(),
     })
 }
 

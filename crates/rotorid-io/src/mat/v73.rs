@@ -99,6 +99,7 @@ fn read_hdf5(
         Ok(Table {
             file: file.to_string(),
             channels,
+            notes: Vec::new(),
         })
     };
     // The HDF5 layer is a third-party parser of a large format: a panic there on a hostile

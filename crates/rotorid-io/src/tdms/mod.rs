@@ -25,7 +25,9 @@
 //! channel's `NI_Scale` properties, as npTDMS does (`tdms/scaling.rs`; a scale type rotorid does
 //! not apply is refused, never returned unscaled). A truncated segment, a chunk that does
 //! not divide the raw data, or interleaved channels of unequal counts are errors naming
-//! the byte offset.
+//! the byte offset; except that a last segment its writer left open (next segment offset
+//! all ones: a recording interrupted mid-segment) is read up to its last whole chunk, and
+//! [`Table::notes`] says how many bytes of the unfinished one were not read.
 
 use std::collections::HashMap;
 
@@ -112,6 +114,7 @@ const BLOCK: u64 = 1 << 18;
 fn read_from<S: Source + ?Sized>(file: &str, src: &S) -> Result<Table, ReadError> {
     let size = src.size();
     let mut objects: Vec<Object> = Vec::new();
+    let mut notes = Vec::new();
     let mut by_path: HashMap<String, usize> = HashMap::new();
     // The object list of the current segment: object, and its raw index there.
     let mut list: Vec<(usize, Option<RawIndex>)> = Vec::new();
@@ -186,8 +189,10 @@ fn read_from<S: Source + ?Sized>(file: &str, src: &S) -> Result<Table, ReadError
                 start: raw_start,
                 end: seg_end,
                 e,
+                open: next == u64::MAX,
             };
-            raw_data(src, &raw, toc & TOC_INTERLEAVED != 0, &mut objects, &list)?;
+            let interleaved = toc & TOC_INTERLEAVED != 0;
+            raw_data(src, &raw, interleaved, &mut objects, &list, &mut notes)?;
         }
         seg = seg_end;
     }
@@ -233,6 +238,7 @@ fn read_from<S: Source + ?Sized>(file: &str, src: &S) -> Result<Table, ReadError
     Ok(Table {
         file: file.to_string(),
         channels,
+        notes,
     })
 }
 
@@ -500,12 +506,15 @@ fn metadata(
     Ok(())
 }
 
-/// Where a segment's raw data lies: file offsets `[start, end)`, byte order `e`.
+/// Where a segment's raw data lies: file offsets `[start, end)`, byte order `e`; `open`
+/// when its writer never closed it (next segment offset `0xFFFFFFFFFFFFFFFF`: a recording
+/// interrupted mid-segment).
 struct Raw<'a> {
     file: &'a str,
     start: u64,
     end: u64,
     e: Endian,
+    open: bool,
 }
 
 impl Raw<'_> {
@@ -562,6 +571,7 @@ fn raw_data<S: Source + ?Sized>(
     interleaved: bool,
     objects: &mut [Object],
     list: &[(usize, Option<RawIndex>)],
+    notes: &mut Vec<String>,
 ) -> Result<(), ReadError> {
     // errors about the whole raw data name its first byte
     let c = Cursor {
@@ -574,14 +584,13 @@ fn raw_data<S: Source + ?Sized>(
         .filter(|(_, i)| i.bytes > 0 || i.daqmx)
         .collect();
     if present.iter().any(|(_, i)| i.daqmx) {
-        return daqmx_data(src, r, &c, &present, objects);
+        return daqmx_data(src, r, &c, &present, objects, notes);
     }
-    let region = r.end - r.start;
     let chunk = present
         .iter()
         .try_fold(0u64, |a, (_, i)| a.checked_add(i.bytes));
-    let Some((chunk, chunks)) = chunk_count(&c, region, chunk, "chunk its object list describes")?
-    else {
+    let layout = "chunk its object list describes";
+    let Some((chunk, chunks)) = chunk_count(&c, r, chunk, layout, notes)? else {
         return Ok(());
     };
     if interleaved {
@@ -619,15 +628,19 @@ fn raw_data<S: Source + ?Sized>(
     Ok(())
 }
 
-/// The chunk size and count of `region` bytes of raw data in chunks of `chunk` bytes
-/// (`None`: beyond 64 bits), `layout` saying what lays them out; `Ok(None)` when there is
-/// nothing to read, an error unless the chunks divide the region.
+/// The chunk size and count of the raw data `r` in chunks of `chunk` bytes (`None`: beyond
+/// 64 bits), `layout` saying what lays them out; `Ok(None)` when there is nothing to read.
+/// The chunks must divide the raw data, except in a segment its writer left open (an
+/// interrupted recording): there the whole chunks are read, and a note says how many bytes
+/// of an unfinished chunk were not.
 fn chunk_count(
     c: &Cursor,
-    region: u64,
+    r: &Raw,
     chunk: Option<u64>,
     layout: &str,
+    notes: &mut Vec<String>,
 ) -> Result<Option<(u64, u64)>, ReadError> {
+    let region = r.end - r.start;
     let Some(chunk) = chunk else {
         return Err(c.invalid(
             "TDMS chunk size",
@@ -638,14 +651,24 @@ fn chunk_count(
     if chunk == 0 || region == 0 {
         return Ok(None);
     }
-    if !region.is_multiple_of(chunk) {
+    let rest = region % chunk;
+    if rest != 0 && !r.open {
         return Err(c.invalid(
             "TDMS raw data size",
             format!("{region} bytes"),
             format!("a multiple of the {chunk}-byte {layout}"),
         ));
     }
-    Ok(Some((chunk, region / chunk)))
+    if rest != 0 {
+        notes.push(format!(
+            "the segment whose raw data starts at byte {} was left open by its writer (an \
+             interrupted recording): its last {rest} bytes, less than one {chunk}-byte chunk, \
+             were not read",
+            r.start
+        ));
+    }
+    let chunks = region / chunk;
+    Ok((chunks > 0).then_some((chunk, chunks)))
 }
 
 /// DAQmx raw data ([`daqmx`]): each chunk is the raw buffers in turn, rows of their width;
@@ -657,6 +680,7 @@ fn daqmx_data<S: Source + ?Sized>(
     c: &Cursor,
     present: &[(usize, RawIndex)],
     objects: &mut [Object],
+    notes: &mut Vec<String>,
 ) -> Result<(), ReadError> {
     if let Some(&(k, _)) = present.iter().find(|(_, i)| !i.daqmx) {
         return Err(c.invalid(
@@ -712,13 +736,11 @@ fn daqmx_data<S: Source + ?Sized>(
         .iter()
         .map(|&(k, _)| index(k).scalers.clone())
         .collect();
-    let region = r.end - r.start;
     let chunk = rows.iter().zip(&widths).try_fold(0u64, |a, (&n, &w)| {
         a.checked_add(n.checked_mul(u64::from(w))?)
     });
-    let Some((chunk, chunks)) =
-        chunk_count(c, region, chunk, "DAQmx chunk its raw buffers describe")?
-    else {
+    let layout = "DAQmx chunk its raw buffers describe";
+    let Some((chunk, chunks)) = chunk_count(c, r, chunk, layout, notes)? else {
         return Ok(());
     };
     let names: Vec<String> = present.iter().map(|&(k, _)| objects[k].name()).collect();
@@ -1424,5 +1446,75 @@ mod tests {
             Err(ReadError::Invalid { what, .. }) => assert_eq!(what, "TDMS DAQmx scaler"),
             other => panic!("{other:?}"),
         }
+    }
+
+    /// `f` (one segment) as its writer leaves it when the recording is interrupted: the
+    /// next segment offset all ones, and the raw data cut `cut` bytes short.
+    fn interrupted(mut f: Vec<u8>, cut: usize) -> Vec<u8> {
+        f[12..20].copy_from_slice(&u64::MAX.to_le_bytes());
+        f.truncate(f.len() - cut);
+        f
+    }
+
+    #[test]
+    fn an_interrupted_recording_keeps_its_whole_chunks_and_says_what_was_not_read() {
+        // two chunks of (a: 3 f64, b: 2 i32): 32 bytes each, the second cut 5 bytes short
+        let mut raw = Vec::new();
+        for k in 0..2i32 {
+            for v in 0..3 {
+                raw.extend(f64::from(10 * k + v).to_le_bytes());
+            }
+            for v in 0..2 {
+                raw.extend((100 * k + v).to_le_bytes());
+            }
+        }
+        let ch = [("a", 10, 3), ("b", 3, 2)];
+        let whole = segment(0, &ch, &raw);
+        let raw_start = whole.len() - raw.len();
+        let t = both(&interrupted(whole.clone(), 5)).unwrap();
+        assert_eq!(t.channels[0].data, [0.0, 1.0, 2.0]);
+        assert_eq!(t.channels[1].data, [0.0, 1.0]);
+        assert_eq!(
+            t.notes,
+            [format!(
+                "the segment whose raw data starts at byte {raw_start} was left open by its \
+                 writer (an interrupted recording): its last 27 bytes, less than one 32-byte \
+                 chunk, were not read"
+            )]
+        );
+        // the same cut in a segment its writer closed is an error, as before
+        let mut closed = whole.clone();
+        closed.truncate(closed.len() - 5);
+        let len = (closed.len() - 28) as u64;
+        closed[12..20].copy_from_slice(&len.to_le_bytes());
+        match both(&closed) {
+            Err(ReadError::Invalid { what, .. }) => assert_eq!(what, "TDMS raw data size"),
+            other => panic!("{other:?}"),
+        }
+        // whole chunks only: no note; less than one chunk: no data, and the note
+        assert!(both(&interrupted(whole.clone(), 0))
+            .unwrap()
+            .notes
+            .is_empty());
+        let t = both(&interrupted(whole, 40)).unwrap();
+        assert!(t.channels.iter().all(|c| c.data.is_empty()));
+        assert!(t.notes[0].contains("its last 24 bytes"), "{:?}", t.notes);
+        // DAQmx: rows of a 4-byte buffer, the last row cut
+        let data = hex("01 00 11 00 02 00 12 00 03 00 13 00 04 00 14");
+        let chans = [
+            raw_channel("Channel1", 4, &[4], &[scaler(0, 3, 0, 0)]),
+            raw_channel("Channel2", 4, &[4], &[scaler(0, 3, 2, 0)]),
+        ];
+        // (one chunk of 4 rows; with 2-row chunks the second one is cut)
+        let chans2 = [
+            raw_channel("Channel1", 2, &[4], &[scaler(0, 3, 0, 0)]),
+            raw_channel("Channel2", 2, &[4], &[scaler(0, 3, 2, 0)]),
+        ];
+        let f = interrupted(daqmx_file(DAQMX, &chans2, &data), 0);
+        let t = both(&f).unwrap();
+        assert_eq!(values(&t, "Channel1"), [1.0, 2.0]);
+        assert_eq!(values(&t, "Channel2"), [17.0, 18.0]);
+        assert_eq!(t.notes.len(), 1, "{:?}", t.notes);
+        assert!(both(&daqmx_file(DAQMX, &chans, &data)).is_err());
     }
 }

@@ -119,6 +119,11 @@ def read(path: str | os.PathLike[str], columns: str | None = None) -> pd.DataFra
         ``df.attrs["units"]`` maps each column the file gave in another unit to that
         unit as written (``{"x": "um", "z": "um"}``; empty for a file in SI).
 
+    Warns:
+        UserWarning: what the reader noted about the file that is not an error, naming
+            it: a TDMS recording interrupted mid-segment, whose unfinished last chunk was
+            not read (the whole chunks before it were).
+
     Raises:
         ValueError: naming the file, line and column of a field that is not a finite
             number, a missing column, a short row, or a unit that is unknown or not one
