@@ -253,12 +253,7 @@ pub fn select(table: &Table, map: &ColumnMap) -> Result<SiColumns, SelectError> 
     let (t, time_from_axis) = match find(0)? {
         Some(c) => (convert(0, c)?, false),
         None => match x.axis.or(z.axis) {
-            Some(axis) if !map.explicit || map.names[0] == ROLES[0] => (
-                (0..n)
-                    .map(|i| axis.start + i as f64 * axis.increment)
-                    .collect(),
-                true,
-            ),
+            Some(axis) if !map.explicit || map.names[0] == ROLES[0] => (axis.times(n), true),
             _ => {
                 return Err(SelectError::NoTime {
                     file: file.to_owned(),

@@ -10,6 +10,15 @@ pub struct TimeAxis {
     pub increment: f64,
 }
 
+impl TimeAxis {
+    /// The times of the first `n` samples \[s\]: `start + i * increment`.
+    pub fn times(&self, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| self.start + i as f64 * self.increment)
+            .collect()
+    }
+}
+
 /// One channel of a file: its name, the unit the file gives, and its samples as stored
 /// (not yet converted to SI; see [`crate::units`]).
 #[derive(Debug, Clone, PartialEq)]

@@ -109,11 +109,7 @@ pub fn raw_record(table: &Table, acq: &Acquisition) -> anyhow::Result<RawRecord>
                 "note: {}: time from the file's time axis of {:?} (no channel {t:?})",
                 table.file, probe.name
             );
-            let n = probe.data.len();
-            let times = (0..n)
-                .map(|i| axis.start + i as f64 * axis.increment)
-                .collect();
-            columns.push((t.clone(), times));
+            columns.push((t.clone(), axis.times(probe.data.len())));
         }
     }
     Ok(RawRecord { columns })
