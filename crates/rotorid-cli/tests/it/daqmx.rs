@@ -11,7 +11,7 @@
 
 use std::path::Path;
 
-use crate::common::{data, first_four_columns, rotorid};
+use crate::common::{data, first_four_columns, identify_outputs, rotorid};
 
 fn run(args: &[&str]) {
     let out = rotorid().args(args).output().unwrap();
@@ -198,24 +198,7 @@ fn a_daqmx_logged_rig_identifies_bit_for_bit_like_its_csv() {
     write_daqmx(&csv, &p("raw.tdms"), 4096, None);
     write_daqmx(&csv, &p("raw_wf.tdms"), 4096, Some(3.90625e-5));
     let outputs = |input: &str, method: &str| {
-        let (est, sum) = (p(&format!("{method}.csv")), p(&format!("{method}.json")));
-        run(&[
-            "identify",
-            p(input).to_str().unwrap(),
-            "--scenario",
-            rig,
-            "--method",
-            method,
-            "--out",
-            est.to_str().unwrap(),
-            "--summary",
-            sum.to_str().unwrap(),
-            "-q",
-        ]);
-        let mut s: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&sum).unwrap()).unwrap();
-        s["input"] = serde_json::Value::Null;
-        (std::fs::read(&est).unwrap(), s)
+        identify_outputs(dir.path(), p(input).to_str().unwrap(), rig, method, &[])
     };
     // (the algebraic method on this steady record gives estimates the model rejects, m < 0:
     // reported with warnings, and the conditioning's second pass keeps the nominal values)

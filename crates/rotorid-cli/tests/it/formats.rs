@@ -9,7 +9,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use crate::common::{data, first_four_columns, rotorid};
+use crate::common::{data, first_four_columns, identify_outputs, rotorid};
 
 fn run(args: &[&str]) -> (String, String) {
     let out = rotorid().args(args).output().unwrap();
@@ -27,27 +27,11 @@ const METHODS: [&str; 3] = ["algebraic", "modulating", "refine"];
 /// `identify REC --scenario table1 --method METHOD [--columns COLUMNS]` into `dir`: the
 /// estimates CSV's bytes and the summary with its "input" (the file's name) nulled.
 fn identify(dir: &Path, rec: &str, method: &str, columns: Option<&str>) -> (Vec<u8>, Value) {
-    let (est, sum) = (dir.join("est.csv"), dir.join("s.json"));
-    let mut args = vec![
-        "identify",
-        rec,
-        "--scenario",
-        "table1",
-        "--method",
-        method,
-        "--out",
-        est.to_str().unwrap(),
-        "--summary",
-        sum.to_str().unwrap(),
-        "-q",
-    ];
-    if let Some(c) = columns {
-        args.extend(["--columns", c]);
-    }
-    run(&args);
-    let mut s = summary(&sum);
-    s["input"] = Value::Null;
-    (std::fs::read(&est).unwrap(), s)
+    let args = match columns {
+        Some(c) => vec!["--columns", c],
+        None => vec![],
+    };
+    identify_outputs(dir, rec, "table1", method, &args)
 }
 
 /// Asserts that `rec` identifies with every method exactly as `reference` did.

@@ -896,6 +896,12 @@ mod tests {
             meta.extend(count.to_le_bytes());
             meta.extend(0u32.to_le_bytes());
         }
+        one_segment(toc, &meta, raw)
+    }
+
+    /// A file of one segment (a new object list with metadata and raw data, plus the `toc`
+    /// bits given) holding `meta` and `raw`, little endian.
+    fn one_segment(toc: u32, meta: &[u8], raw: &[u8]) -> Vec<u8> {
         let mut f = b"TDSm".to_vec();
         f.extend((toc | TOC_META | TOC_NEW_LIST | TOC_RAW).to_le_bytes());
         f.extend(4713u32.to_le_bytes());
@@ -1096,14 +1102,7 @@ mod tests {
         for o in objects {
             meta.extend(o);
         }
-        let mut f = b"TDSm".to_vec();
-        f.extend((toc | TOC_META | TOC_NEW_LIST | TOC_RAW).to_le_bytes());
-        f.extend(4713u32.to_le_bytes());
-        f.extend(((meta.len() + data.len()) as u64).to_le_bytes());
-        f.extend((meta.len() as u64).to_le_bytes());
-        f.extend(meta);
-        f.extend(data);
-        f
+        one_segment(toc, &meta, data)
     }
 
     const DAQMX: u32 = 0x80;

@@ -91,3 +91,43 @@ pub fn first_four_columns(text: &str) -> Vec<[f64; 4]> {
         })
         .collect()
 }
+
+/// `identify REC --scenario SCENARIO --method METHOD ARGS` into `dir`: the estimates CSV's
+/// bytes and the summary with its "input" (the file's name) nulled, to compare the outputs
+/// of one record in two files.
+pub fn identify_outputs(
+    dir: &std::path::Path,
+    rec: &str,
+    scenario: &str,
+    method: &str,
+    args: &[&str],
+) -> (Vec<u8>, Value) {
+    let (est, sum) = (dir.join("est.csv"), dir.join("s.json"));
+    let out = rotorid()
+        .args([
+            "identify",
+            rec,
+            "--scenario",
+            scenario,
+            "--method",
+            method,
+            "-q",
+        ])
+        .args([
+            "--out",
+            est.to_str().unwrap(),
+            "--summary",
+            sum.to_str().unwrap(),
+        ])
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "identify {rec} --method {method}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut s: Value = serde_json::from_str(&std::fs::read_to_string(&sum).unwrap()).unwrap();
+    s["input"] = Value::Null;
+    (std::fs::read(&est).unwrap(), s)
+}
