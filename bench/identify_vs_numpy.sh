@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # End to end, `rotorid identify` against the same identifier written with numpy/pandas
-# (bench/numpy_identify.py: pandas.read_csv plus the vectorised identifier), both on one
-# 1,000,001-row response CSV (table1, 100 s at 10 kHz) and on the same record as binary
-# files, timed in turn (A B A B ...) in one run; prints medians and the ratio.
+# (bench/numpy_identify.py: pandas.read_csv plus the vectorised identifier, trapezoid rule),
+# on one 1,000,001-row response CSV (table1, 100 s at 10 kHz), all timed in turn (A B C D
+# A B C D ...) in one run; prints medians and numpy's time over each. Three rotorid runs:
+# the same identifier (--quadrature trapezoid), the default one (Adams-Moulton 5), and
+# `rotorid inspect` of the same file, which reads and parses every value and identifies
+# nothing: the floor any `identify` of a CSV stays above.
 #
 #   bash bench/identify_vs_numpy.sh [RUNS]      (default 5)
 #
@@ -32,11 +35,15 @@ fi
 "$py" - "$runs" "$rotorid" "$py" "$csv" "$data" <<'EOF'
 import statistics, subprocess, sys, time
 runs, rotorid, py, csv, data = int(sys.argv[1]), *sys.argv[2:]
+numpy = "numpy/pandas identifier, trapezoid --every 1000"
 cases = {
-    "rotorid identify --every 1000 (CSV)": [rotorid, "identify", csv, "--scenario", "table1",
-        "--every", "1000", "--out", f"{data}/est_rs.csv"],
-    "numpy/pandas identifier --every 1000 (CSV)": [py, "bench/numpy_identify.py", csv,
-        f"{data}/est_np.csv", "--every", "1000"],
+    "rotorid identify --quadrature trapezoid --every 1000": [rotorid, "identify", csv,
+        "--scenario", "table1", "--quadrature", "trapezoid", "--every", "1000",
+        "--out", f"{data}/est_rs_trapezoid.csv"],
+    "rotorid identify --every 1000 (default am5)": [rotorid, "identify", csv, "--scenario",
+        "table1", "--every", "1000", "--out", f"{data}/est_rs.csv"],
+    "rotorid inspect (reading alone: the floor)": [rotorid, "inspect", csv],
+    numpy: [py, "bench/numpy_identify.py", csv, f"{data}/est_np.csv", "--every", "1000"],
 }
 times = {k: [] for k in cases}
 for k, cmd in cases.items():  # warm-up
@@ -48,7 +55,9 @@ for _ in range(runs):
         times[k].append(time.perf_counter() - t0)
 med = {k: statistics.median(v) for k, v in times.items()}
 for k, v in med.items():
-    print(f"{k:48s} median {v:.3f} s over {runs} runs (min {min(times[k]):.3f})")
-a, b = list(med.values())
-print(f"numpy/pandas over rotorid: {b / a:.1f}x")
+    print(f"{k:56s} median {v:.3f} s over {runs} runs (min {min(times[k]):.3f})")
+for k, v in med.items():
+    if k != numpy:
+        pairs = statistics.median(b / a for a, b in zip(times[k], times[numpy]))
+        print(f"numpy/pandas over {k}: {med[numpy] / v:.1f}x (median of pairs {pairs:.1f}x)")
 EOF
