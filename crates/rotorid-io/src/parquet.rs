@@ -89,7 +89,7 @@ fn read_inner<R: ChunkReader + 'static>(
     size: u64,
     chunk: &ChunkFn<'_>,
 ) -> Result<Table, ReadError> {
-    check_footer(file, size, chunk)?;
+    let footer = check_footer(file, size, chunk)?;
     let reader = SerializedFileReader::new(source).map_err(|e| err(file, None, e))?;
     let meta = reader.metadata();
     let schema = meta.file_metadata().schema_descr();
@@ -103,8 +103,9 @@ fn read_inner<R: ChunkReader + 'static>(
         return Err(ReadError::Invalid {
             file: file.to_string(),
             channel: None,
-            offset: 0,
-            what: "Parquet footer row count".into(),
+            // the row groups' counts are fields of the footer that starts there
+            offset: footer,
+            what: "Parquet footer row count (the row groups' num_rows together)".into(),
             found: rows.to_string(),
             allowed: format!("at most {limit} (1032 times the file's size)"),
         });
@@ -338,18 +339,19 @@ fn read_chunk<R: ChunkReader + 'static>(
 ///   type, and list elements too;
 /// - nesting stops at 80 levels.
 ///
-/// A footer that does not end in `PAR1` is left to the crate's error.
-fn check_footer(file: &str, size: u64, chunk: &ChunkFn<'_>) -> Result<(), ReadError> {
+/// A footer that does not end in `PAR1` is left to the crate's error. Returns where the
+/// footer starts (0 when it is left to the crate: the crate then refuses the file).
+fn check_footer(file: &str, size: u64, chunk: &ChunkFn<'_>) -> Result<u64, ReadError> {
     if size < 12 {
-        return Ok(());
+        return Ok(0);
     }
     let tail = chunk(size - 8, 8)?;
     if tail[4..] != *b"PAR1" {
-        return Ok(());
+        return Ok(0);
     }
     let len = u64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
     if len > size - 8 {
-        return Ok(());
+        return Ok(0);
     }
     let start = size - 8 - len;
     let bytes = chunk(start, len)?;
@@ -368,7 +370,7 @@ fn check_footer(file: &str, size: u64, chunk: &ChunkFn<'_>) -> Result<(), ReadEr
             ),
         ));
     }
-    Ok(())
+    Ok(start)
 }
 
 /// Walks the page headers of a column chunk of `len` bytes at `start` (in a file of `size`

@@ -245,6 +245,51 @@ fn parquet_footers_the_parquet_crate_would_spin_on_are_refused_first() {
     assert_footer_refused("typed.parquet", &parquet_with_footer(&typed), 4 + 1);
 }
 
+/// Thrift compact's varint of the zigzag of `v`.
+fn zigzag_varint(v: i64) -> Vec<u8> {
+    let mut z = ((v << 1) ^ (v >> 63)) as u64;
+    let mut out = Vec::new();
+    loop {
+        let b = (z & 0x7F) as u8;
+        z >>= 7;
+        if z == 0 {
+            out.push(b);
+            return out;
+        }
+        out.push(b | 0x80);
+    }
+}
+
+#[test]
+fn a_parquet_footer_claiming_more_rows_than_the_file_can_hold_is_named_at_the_footer() {
+    // FileMetaData { version 1, schema [root "schema" of 0 children], num_rows N,
+    // row_groups [RowGroup { columns [], total_byte_size 0, num_rows N }] }, N = 10^12:
+    // a well-formed footer whose row count is beyond 1032 times the file's size
+    let n = zigzag_varint(1_000_000_000_000);
+    let mut footer = vec![0x15, 0x02, 0x19, 0x1C, 0x48, 6];
+    footer.extend_from_slice(b"schema");
+    footer.extend_from_slice(&[0x15, 0x00, 0x00, 0x16]);
+    footer.extend_from_slice(&n);
+    footer.extend_from_slice(&[0x19, 0x1C, 0x19, 0x0C, 0x16, 0x00, 0x16]);
+    footer.extend_from_slice(&n);
+    footer.extend_from_slice(&[0x00, 0x00]);
+    let bytes = parquet_with_footer(&footer);
+    for e in refusals(Format::Parquet, "rows.parquet", &bytes) {
+        match &e {
+            ReadError::Invalid {
+                what,
+                offset,
+                found,
+                ..
+            } if what.starts_with("Parquet footer row count") => {
+                // the footer starts right after the leading magic
+                assert_eq!((*offset, found.as_str()), (4, "1000000000000"), "{e}");
+            }
+            _ => panic!("{e}"),
+        }
+    }
+}
+
 #[test]
 fn skipped_variables_are_listed_when_nothing_is_left() {
     // The header and the variables M (a matrix), c (complex) and note (char) of rec_v5.mat:

@@ -16,9 +16,12 @@
 //! integer exactly or not at all. Before a dataset is read, its element count times element
 //! size is checked against 1032 times the file's size (deflate's largest ratio), so a forged
 //! shape cannot make the reader allocate without bound. Errors of the HDF5 layer are
-//! reported as [`ReadError::Container`] with the crate's message.
+//! reported as [`ReadError::Container`] with the crate's message. Errors about a dataset's
+//! values give the byte of the value (contiguous storage, an unfiltered chunk) or of its
+//! compressed chunk; errors about the dataset as a whole, the byte its data starts at (the
+//! HDF5 layer does not give the address of the object header that holds its shape).
 
-use hdf5_pure::{AttrValue, DType, Dataset, File, Group};
+use hdf5_pure::{AttrValue, DType, Dataset, File, Group, Layout};
 
 use crate::error::ReadError;
 use crate::table::{Channel, Table};
@@ -164,8 +167,8 @@ fn vector(
             return Err(ReadError::Invalid {
                 file: file.to_string(),
                 channel: Some(name.to_string()),
-                offset: 0,
-                what: "HDF5 dataset extent".into(),
+                offset: data_start(ds),
+                what: "HDF5 dataset extent (of the dataset whose data starts here)".into(),
                 found: format!("{shown} elements of {size} bytes"),
                 allowed: format!("at most {limit} bytes (1032 times the file's size)"),
             })
@@ -187,7 +190,7 @@ fn vector(
                         file: file.to_string(),
                         channel: name.to_string(),
                         index,
-                        offset: 0,
+                        offset: sample_offset(ds, &shape, index as u64, size),
                         value: x,
                     })
                 }
@@ -260,13 +263,84 @@ fn vector(
         return Err(ReadError::Invalid {
             file: file.to_string(),
             channel: Some(name.to_string()),
-            offset: 0,
+            offset: data_start(ds),
             what: "HDF5 dataset".into(),
             found: format!("{} values", data.len()),
             allowed: format!("{numel} (its shape {shown})"),
         });
     }
     Ok(Ok(data))
+}
+
+/// The byte where the data of `ds` starts: its contiguous storage, else its first chunk
+/// (in index order); 0 when the layout does not say (compact storage, inside the object
+/// header; storage not allocated; a chunk index the HDF5 layer cannot list).
+fn data_start(ds: &Dataset) -> u64 {
+    match ds.layout() {
+        Ok(Layout::Contiguous {
+            address: Some(a), ..
+        }) => a,
+        Ok(Layout::Chunked { .. }) => ds
+            .chunks()
+            .ok()
+            .and_then(|c| c.iter().map(|c| c.address).min())
+            .unwrap_or(0),
+        _ => 0,
+    }
+}
+
+/// The byte where sample `index` (row-major over `shape`, elements of `size` bytes) of `ds`
+/// is stored: its own bytes in contiguous storage or in a chunk stored unfiltered, the start
+/// of its chunk when that chunk is compressed; else as [`data_start`].
+fn sample_offset(ds: &Dataset, shape: &[u64], index: u64, size: u64) -> u64 {
+    let within = |start: u64, k: u64| start.saturating_add(k.saturating_mul(size));
+    match ds.layout() {
+        Ok(Layout::Contiguous {
+            address: Some(a), ..
+        }) => within(a, index),
+        Ok(Layout::Chunked { chunk_shape, .. }) if chunk_shape.len() == shape.len() => {
+            // the sample's coordinates, last dimension fastest
+            let mut coords = vec![0u64; shape.len()];
+            let mut rest = index;
+            for (c, &d) in coords.iter_mut().zip(shape).rev() {
+                if d > 0 {
+                    *c = rest % d;
+                    rest /= d;
+                }
+            }
+            let filters = ds.filters().len();
+            let chunk = ds.chunks().ok().and_then(|chunks| {
+                chunks.into_iter().find(|c| {
+                    c.offset.len() == coords.len()
+                        && coords
+                            .iter()
+                            .zip(&c.offset)
+                            .zip(&chunk_shape)
+                            .all(|((&x, &o), &n)| x >= o && x - o < n)
+                })
+            });
+            match chunk {
+                Some(c) => {
+                    let raw = filters == 0 || c.filter_mask.count_ones() as usize >= filters;
+                    if raw {
+                        // position in the chunk, row-major over the chunk's shape
+                        let k = coords
+                            .iter()
+                            .zip(&c.offset)
+                            .zip(&chunk_shape)
+                            .fold(0u64, |k, ((&x, &o), &n)| {
+                                k.saturating_mul(n).saturating_add(x - o)
+                            });
+                        within(c.address, k)
+                    } else {
+                        c.address
+                    }
+                }
+                None => data_start(ds),
+            }
+        }
+        _ => data_start(ds),
+    }
 }
 
 /// A variable read as a vector becomes channel `name`; one that is not, a line of `skipped`.
@@ -284,5 +358,92 @@ fn keep(
             axis: None,
         }),
         Err(why) => skipped.push(format!("{name}: {why}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Read;
+
+    const BAD: i64 = (1 << 53) + 1;
+
+    /// A MAT v7.3 layout (512-byte user block) holding the int64 column `n` = [1, 2, BAD,
+    /// 4, 5, 6] stored as `store` sets it up.
+    fn file(store: impl Fn(&mut hdf5_pure::DatasetBuilder)) -> Vec<u8> {
+        let mut b = hdf5_pure::FileBuilder::new();
+        b.with_userblock(512);
+        let ds = b
+            .create_dataset("n")
+            .with_i64_data(&[1, 2, BAD, 4, 5, 6])
+            .with_shape(&[1, 6])
+            .set_attr("MATLAB_class", AttrValue::String("int64".into()));
+        store(ds);
+        b.finish().unwrap()
+    }
+
+    fn inexact_offset(bytes: &[u8]) -> u64 {
+        match read("n.mat", bytes) {
+            Err(ReadError::InexactInteger {
+                channel,
+                index,
+                offset,
+                value,
+                ..
+            }) => {
+                assert_eq!((channel.as_str(), index, value), ("n", 2, i128::from(BAD)));
+                offset
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn an_inexact_integer_is_named_at_its_bytes_when_stored_plain() {
+        for (what, bytes) in [
+            ("contiguous", file(|_| {})),
+            (
+                "chunked",
+                file(|d| {
+                    d.with_chunks(&[1, 2]);
+                }),
+            ),
+        ] {
+            let at = inexact_offset(&bytes) as usize;
+            assert_eq!(bytes[at..at + 8], BAD.to_le_bytes(), "{what}");
+        }
+    }
+
+    #[test]
+    fn an_inexact_integer_in_a_compressed_chunk_is_named_at_that_chunk() {
+        let bytes = file(|d| {
+            d.with_chunks(&[1, 2]).with_deflate(6);
+        });
+        let at = inexact_offset(&bytes) as usize;
+        // a zlib stream starts there, and it inflates to the second chunk: [BAD, 4]
+        let mut chunk = Vec::new();
+        flate2::read::ZlibDecoder::new(&bytes[at..])
+            .read_to_end(&mut chunk)
+            .unwrap();
+        let want: Vec<u8> = [BAD, 4].iter().flat_map(|v| v.to_le_bytes()).collect();
+        assert_eq!(chunk, want);
+    }
+
+    #[test]
+    fn the_data_start_is_the_first_values_bytes() {
+        // what an error about a whole dataset names (a forged extent, a short read): the
+        // file's object headers are checksummed, so this is checked on good files
+        let first: Vec<u8> = [1i64, 2].iter().flat_map(|v| v.to_le_bytes()).collect();
+        for bytes in [
+            file(|_| {}),
+            file(|d| {
+                d.with_chunks(&[1, 2]);
+            }),
+        ] {
+            let want = bytes.windows(16).position(|w| w == first).unwrap() as u64;
+            let h5 = File::from_bytes(bytes).unwrap();
+            let ds = h5.root().dataset("n").unwrap();
+            assert_eq!(data_start(&ds), want);
+        }
     }
 }

@@ -68,7 +68,8 @@ struct Object {
     path: Vec<String>,
     unit: Option<String>,
     start: Option<f64>,
-    increment: Option<f64>,
+    /// `wf_increment` \[s\] and the file offset of its value.
+    increment: Option<(f64, u64)>,
     numeric: bool,
     last: Option<RawIndex>,
     data: Vec<f64>,
@@ -207,15 +208,15 @@ fn read_from<S: Source + ?Sized>(file: &str, src: &S) -> Result<Table, ReadError
         let name = o.name();
         let axis = match o.increment {
             None => None,
-            Some(inc) if inc > 0.0 && inc.is_finite() => Some(TimeAxis {
+            Some((inc, _)) if inc > 0.0 && inc.is_finite() => Some(TimeAxis {
                 start: o.start.unwrap_or(0.0),
                 increment: inc,
             }),
-            Some(inc) => {
+            Some((inc, at)) => {
                 return Err(ReadError::Invalid {
                     file: file.to_string(),
                     channel: Some(name),
-                    offset: 0,
+                    offset: at,
                     what: "TDMS property wf_increment".into(),
                     found: inc.to_string(),
                     allowed: "a positive finite number of seconds".into(),
@@ -493,7 +494,7 @@ fn metadata(
                         let ch = c.channel.clone().unwrap_or_default();
                         let v = c.samples(vat, 1, size, d, e, &ch)?[0];
                         match name {
-                            "wf_increment" => o.increment = Some(v),
+                            "wf_increment" => o.increment = Some((v, c.offset_of(vat))),
                             "wf_start_offset" => o.start = Some(v),
                             _ => o.props.set(name, Value::Number(v), pat),
                         }
@@ -1003,6 +1004,40 @@ mod tests {
         match both(&f) {
             Err(ReadError::InexactInteger { channel, index, .. }) => {
                 assert_eq!((channel.as_str(), index), ("g/b", n as usize + 20_000));
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_bad_wf_increment_is_named_at_its_value() {
+        // one f64 channel of 2 values whose wf_increment (a double) is -1: the error names
+        // the byte where that double starts
+        let path = "/'g'/'a'";
+        let mut meta = 1u32.to_le_bytes().to_vec();
+        meta.extend((path.len() as u32).to_le_bytes());
+        meta.extend(path.as_bytes());
+        meta.extend(20u32.to_le_bytes());
+        meta.extend(10u32.to_le_bytes());
+        meta.extend(1u32.to_le_bytes());
+        meta.extend(2u64.to_le_bytes());
+        meta.extend(props_bytes(&[(
+            "wf_increment",
+            10,
+            (-1.0f64).to_le_bytes().to_vec(),
+        )]));
+        let raw: Vec<u8> = [0.5f64, 1.5].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let f = one_segment(0, &meta, &raw);
+        let value_at = f
+            .windows(8)
+            .position(|w| w == (-1.0f64).to_le_bytes())
+            .unwrap() as u64;
+        match both(&f) {
+            Err(ReadError::Invalid {
+                channel, offset, ..
+            }) => {
+                assert_eq!(channel.as_deref(), Some("g/a"));
+                assert_eq!(offset, value_at);
             }
             other => panic!("{other:?}"),
         }
