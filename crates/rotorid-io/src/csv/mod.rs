@@ -8,9 +8,12 @@
 //!   a line's length, so a file that is not line-based text cannot exhaust memory;
 //! - [`error`]: [`CsvError`], `FILE line L, column C (NAME): message`;
 //! - [`number`]: numbers written in shortest round-trip form (reading one back gives the
-//!   identical `f64`) and read as `str::parse::<f64>` reads them.
+//!   identical `f64`) and read as `str::parse::<f64>` reads them;
+//! - [`decimal`]: the fast path for plain decimals in front of fast-float2 (the same values,
+//!   bit for bit).
 
 pub mod columns;
+pub mod decimal;
 pub mod error;
 pub mod lines;
 pub mod number;

@@ -19,7 +19,8 @@
 //! (tested on random bit patterns), at a fraction of the cost.
 //!
 //! Numbers are read with [`parse_f64`]: `str::parse::<f64>` after trimming blanks, bit for
-//! bit, through `fast-float2` for plain decimal text (tested against `str::parse`).
+//! bit, through [`super::decimal`]'s fast path and `fast-float2` for plain decimal text
+//! (both tested against `str::parse`).
 //!
 //! Numbers in messages go through [`readable`]: the same text, with an exponent written as
 //! `1.0e300` (a decimal point in the mantissa), so a huge or tiny value is never printed
@@ -196,14 +197,20 @@ fn push_exponent(out: &mut Vec<u8>, e: i32) {
 }
 
 /// `raw` (a field, ASCII blanks already trimmed) as `str::parse::<f64>` reads it after
-/// `str::trim`, bit for bit; `None` where that refuses it. `fast-float2` first: it
-/// accepts exactly the texts `str::parse` accepts (decimal with sign, point and exponent;
-/// `inf`, `infinity`, `nan` in any case, signed) and rounds them correctly as it does (the
-/// property tests below check both claims); what it refuses (Unicode blanks, garbage)
-/// goes to `str::parse`, which trims and decides. No pre-scan of the bytes: that cost a
-/// third of the CSV reader's time.
+/// `str::trim`, bit for bit; `None` where that refuses it. The plain-decimal fast path
+/// ([`super::decimal::parse_prefix`], the same values as fast-float2) first, then
+/// `fast-float2`: it accepts exactly the texts `str::parse` accepts (decimal with sign,
+/// point and exponent; `inf`, `infinity`, `nan` in any case, signed) and rounds them
+/// correctly as it does (the property tests below check both claims); what it refuses
+/// (Unicode blanks, garbage) goes to `str::parse`, which trims and decides. No pre-scan of
+/// the bytes: that cost a third of the CSV reader's time.
 #[inline]
 pub fn parse_f64(raw: &[u8]) -> Option<f64> {
+    if let Some((v, n)) = super::decimal::parse_prefix(raw) {
+        if n == raw.len() {
+            return Some(v);
+        }
+    }
     if let Ok(v) = fast_float2::parse::<f64, _>(raw) {
         return Some(v);
     }
