@@ -40,18 +40,9 @@ pub const Q_MAX: i32 = 64;
 #[inline]
 pub fn parse_prefix(s: &[u8]) -> Option<(f64, usize)> {
     let neg = s.first() == Some(&b'-');
-    let mut i = usize::from(neg);
-    let start = i;
-    let mut w: u64 = 0;
+    let start = usize::from(neg);
     // integer digits (a leading zero stays in the count: at most 19 digits together)
-    while let Some(&c) = s.get(i) {
-        let d = c.wrapping_sub(b'0');
-        if d > 9 {
-            break;
-        }
-        w = w.wrapping_mul(10).wrapping_add(u64::from(d));
-        i += 1;
-    }
+    let (mut i, mut w) = digits_from(s, start, 0);
     let mut digits = i - start;
     let mut q: i32 = 0;
     if s.get(i) == Some(&b'.') {
@@ -67,14 +58,7 @@ pub fn parse_prefix(s: &[u8]) -> Option<(f64, usize)> {
                 return None;
             }
         }
-        while let Some(&c) = s.get(i) {
-            let d = c.wrapping_sub(b'0');
-            if d > 9 {
-                break;
-            }
-            w = w.wrapping_mul(10).wrapping_add(u64::from(d));
-            i += 1;
-        }
+        (i, w) = digits_from(s, i, w);
         digits += i - f;
         q = -((i - f) as i32);
     }
@@ -115,6 +99,21 @@ pub fn parse_prefix(s: &[u8]) -> Option<(f64, usize)> {
     }
     let v = to_f64(w, q)?;
     Some((if neg { -v } else { v }, i))
+}
+
+/// The digits of `s` from `i` appended to `w` one by one: where they end, and `w` (which
+/// wraps past 19 digits in all; the caller refuses those).
+#[inline(always)]
+fn digits_from(s: &[u8], mut i: usize, mut w: u64) -> (usize, u64) {
+    while let Some(&c) = s.get(i) {
+        let d = c.wrapping_sub(b'0');
+        if d > 9 {
+            break;
+        }
+        w = w.wrapping_mul(10).wrapping_add(u64::from(d));
+        i += 1;
+    }
+    (i, w)
 }
 
 /// The 8 bytes of `s` from `i`, little endian, when there are 8.
