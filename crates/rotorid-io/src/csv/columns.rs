@@ -132,10 +132,10 @@ impl Header {
 
 /// The numbers of the plain line `text` (no quote, line end excluded) in one pass, for the
 /// readers' fast path: `cols` fields separated by `,`; field `j` is parsed where it starts by
-/// [`super::decimal::parse_prefix`], else fast-float2's `parse_partial` (the same values as
-/// [`number_field`] gives, bit for bit) when `used(j)` and must be exactly one number of at
-/// most [`MAX_FIELD_BYTES`] bytes, then `take(j, value)` decides (`None`: the line needs the general path); an unused
-/// field is skipped to the next `,`. `None` for anything else (blanks, an empty or
+/// [`super::decimal::number_prefix`] (the parser [`number_field`] uses, so a value is the
+/// same bit for bit) when `used(j)` and must be exactly one number of at most
+/// [`MAX_FIELD_BYTES`] bytes, then `take(j, value)` decides (`None`: the line needs the
+/// general path); an unused field is skipped to the next `,`. `None` for anything else (blanks, an empty or
 /// non-number field, another field count): the caller then splits and checks the line
 /// field by field, which names what is wrong.
 #[inline]
@@ -179,10 +179,7 @@ fn fields(
     for j in 0..cols {
         let rest = text.get(p..)?;
         if used(j) {
-            let (v, n) = match super::decimal::parse_prefix(rest) {
-                Some(taken) => taken,
-                None => fast_float2::parse_partial::<f64, _>(rest).ok()?,
-            };
+            let (v, n) = super::decimal::number_prefix(rest)?;
             if n > MAX_FIELD_BYTES {
                 return None;
             }

@@ -1,7 +1,7 @@
 //! A fast path for the plain decimals of CSV files (`-0.0125`, `5.889325051644407e-11`,
 //! `125.66370614359172`), in front of fast-float2: what it takes it reads bit for bit as
 //! fast-float2's `parse_partial` (and so `str::parse::<f64>`) reads it, consuming the same
-//! bytes; anything else it declines (`None`) and the caller asks fast-float2.
+//! bytes; anything else it declines (`None`) and [`number_prefix`] asks fast-float2.
 //!
 //! Taken: an optional `-`, decimal digits with at most one `.` (19 significant digits at
 //! most, leading zeros included), an optional exponent `e`/`E` with an optional sign and 1
@@ -35,8 +35,19 @@ pub const Q_MIN: i32 = -64;
 /// Largest decimal exponent taken.
 pub const Q_MAX: i32 = 64;
 
+/// The number at the start of `s` as fast-float2's `parse_partial` reads it, `(value, bytes
+/// consumed)`, or `None` where it reads none: the fast path when it takes the text, else
+/// fast-float2 itself. What the CSV readers call.
+#[inline]
+pub fn number_prefix(s: &[u8]) -> Option<(f64, usize)> {
+    match parse_prefix(s) {
+        Some(taken) => Some(taken),
+        None => fast_float2::parse_partial::<f64, _>(s).ok(),
+    }
+}
+
 /// The plain decimal at the start of `s` as `(value, bytes consumed)`, or `None` (module
-/// doc): then fast-float2 decides.
+/// doc): then fast-float2 decides ([`number_prefix`]).
 #[inline]
 pub fn parse_prefix(s: &[u8]) -> Option<(f64, usize)> {
     let neg = s.first() == Some(&b'-');

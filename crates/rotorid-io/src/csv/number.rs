@@ -197,22 +197,19 @@ fn push_exponent(out: &mut Vec<u8>, e: i32) {
 }
 
 /// `raw` (a field, ASCII blanks already trimmed) as `str::parse::<f64>` reads it after
-/// `str::trim`, bit for bit; `None` where that refuses it. The plain-decimal fast path
-/// ([`super::decimal::parse_prefix`], the same values as fast-float2) first, then
-/// `fast-float2`: it accepts exactly the texts `str::parse` accepts (decimal with sign,
-/// point and exponent; `inf`, `infinity`, `nan` in any case, signed) and rounds them
-/// correctly as it does (the property tests below check both claims); what it refuses
-/// (Unicode blanks, garbage) goes to `str::parse`, which trims and decides. No pre-scan of
-/// the bytes: that cost a third of the CSV reader's time.
+/// `str::trim`, bit for bit; `None` where that refuses it. First
+/// [`super::decimal::number_prefix`] (its fast path, then fast-float2, which accepts exactly
+/// the texts `str::parse` accepts: decimal with sign, point and exponent; `inf`,
+/// `infinity`, `nan` in any case, signed; and rounds them correctly as it does: the
+/// property tests below check both claims), taken when the number is the whole field; what
+/// that refuses (Unicode blanks, garbage) goes to `str::parse`, which trims and decides. No
+/// pre-scan of the bytes: that cost a third of the CSV reader's time.
 #[inline]
 pub fn parse_f64(raw: &[u8]) -> Option<f64> {
-    if let Some((v, n)) = super::decimal::parse_prefix(raw) {
+    if let Some((v, n)) = super::decimal::number_prefix(raw) {
         if n == raw.len() {
             return Some(v);
         }
-    }
-    if let Ok(v) = fast_float2::parse::<f64, _>(raw) {
-        return Some(v);
     }
     std::str::from_utf8(raw)
         .ok()

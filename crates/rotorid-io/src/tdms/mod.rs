@@ -888,16 +888,23 @@ mod tests {
         let mut meta = Vec::new();
         meta.extend((channels.len() as u32).to_le_bytes());
         for &(name, t, count) in channels {
-            let path = format!("/'g'/'{name}'");
-            meta.extend((path.len() as u32).to_le_bytes());
-            meta.extend(path.as_bytes());
-            meta.extend(20u32.to_le_bytes());
-            meta.extend(t.to_le_bytes());
-            meta.extend(1u32.to_le_bytes());
-            meta.extend(count.to_le_bytes());
-            meta.extend(0u32.to_le_bytes());
+            meta.extend(channel_meta(name, t, count, &[]));
         }
         one_segment(toc, &meta, raw)
+    }
+
+    /// The metadata of channel `/'g'/'name'`: a raw data index of `count` values of type
+    /// code `t`, then its properties.
+    fn channel_meta(name: &str, t: u32, count: u64, props: &[Prop]) -> Vec<u8> {
+        let path = format!("/'g'/'{name}'");
+        let mut meta = (path.len() as u32).to_le_bytes().to_vec();
+        meta.extend(path.as_bytes());
+        meta.extend(20u32.to_le_bytes());
+        meta.extend(t.to_le_bytes());
+        meta.extend(1u32.to_le_bytes());
+        meta.extend(count.to_le_bytes());
+        meta.extend(props_bytes(props));
+        meta
     }
 
     /// A file of one segment (a new object list with metadata and raw data, plus the `toc`
@@ -1013,19 +1020,9 @@ mod tests {
     fn a_bad_wf_increment_is_named_at_its_value() {
         // one f64 channel of 2 values whose wf_increment (a double) is -1: the error names
         // the byte where that double starts
-        let path = "/'g'/'a'";
         let mut meta = 1u32.to_le_bytes().to_vec();
-        meta.extend((path.len() as u32).to_le_bytes());
-        meta.extend(path.as_bytes());
-        meta.extend(20u32.to_le_bytes());
-        meta.extend(10u32.to_le_bytes());
-        meta.extend(1u32.to_le_bytes());
-        meta.extend(2u64.to_le_bytes());
-        meta.extend(props_bytes(&[(
-            "wf_increment",
-            10,
-            (-1.0f64).to_le_bytes().to_vec(),
-        )]));
+        let increment = ("wf_increment", 10, (-1.0f64).to_le_bytes().to_vec());
+        meta.extend(channel_meta("a", 10, 2, &[increment]));
         let raw: Vec<u8> = [0.5f64, 1.5].iter().flat_map(|v| v.to_le_bytes()).collect();
         let f = one_segment(0, &meta, &raw);
         let value_at = f
