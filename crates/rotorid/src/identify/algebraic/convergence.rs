@@ -20,11 +20,13 @@
 //! above F + d (resp. below F - d) is found by scanning from the top; the answer is the
 //! instant right after it. O(1) amortised per estimate; the answer costs O(stack).
 //!
-//! The values reach the staircases in blocks of 64 per parameter: within a block, one
-//! backward scan keeps the values that exceed everything after them, the block's largest
-//! value pops what it would have popped, and the survivors are pushed. The staircases are
-//! bit for bit those of one-by-one pushes (when a stack could fill up during a block, its
-//! values go one by one), without a hard-to-predict pop loop per value.
+//! The values reach the staircases in blocks of 64 instants: within a block, one backward
+//! scan of all twelve staircases at once (six parameters, v and -v, side by side in vector
+//! registers; an instant a parameter does not keep holds -inf there) marks the values that
+//! exceed everything after them, the block's largest value pops what it would have popped,
+//! and the survivors are pushed. The staircases are bit for bit those of one-by-one pushes
+//! (when a stack could fill up during a block, its values go one by one), without a
+//! hard-to-predict pop loop per value.
 //!
 //! ## Bounded memory and its price
 //!
@@ -129,57 +131,53 @@ impl Staircase {
         });
     }
 
-    /// Push the values `sign * v[i]` at times `t[i]` (at most [`BLOCK`]), with the same
-    /// result as pushing them one by one. Within the block, a value survives when it
-    /// exceeds every later one (one backward scan, whose branch is rarely taken, instead
-    /// of a pop loop per value whose exit is hard to predict); the block's largest value
-    /// pops what it would have popped, and the survivors are pushed in order. When the
-    /// stack could fill up during the block, the values go one by one, so that compaction
-    /// happens exactly when it would have.
-    fn push_block(&mut self, t: &[f64], v: &[f64], sign: f64) {
-        let n = t.len();
-        debug_assert!(n == v.len() && n <= BLOCK);
-        if n == 0 {
+    /// Push a block's kept values with the same result as pushing them one by one:
+    /// `kept` (bit i: instant i of the block is kept), their times `t[i]` and values
+    /// `v(i)`, the block's survivors `survivors` (the kept instants whose value exceeds
+    /// every later kept one, [`Block::scan`]) and its largest kept value `top`. The
+    /// largest value pops what it would have popped and the survivors are pushed in
+    /// order. When the stack could fill up during the block, the values go one by one, so
+    /// that compaction happens exactly when it would have.
+    fn push_survivors(
+        &mut self,
+        t: &[f64; BLOCK],
+        v: impl Fn(usize) -> f64,
+        kept: u64,
+        survivors: u64,
+        top: f64,
+    ) {
+        if kept == 0 {
             return;
         }
-        if self.steps.len() + n >= self.cap {
-            for (&t, &v) in t.iter().zip(v) {
-                self.push(t, sign * v);
+        if self.steps.len() + kept.count_ones() as usize >= self.cap {
+            for i in bits(kept) {
+                self.push(t[i], v(i));
             }
             return;
         }
-        // survivors, last first
-        let mut survivors = [0u8; BLOCK];
-        let mut k = 0;
-        let mut later_max = f64::NEG_INFINITY;
-        for i in (0..n).rev() {
-            let x = sign * v[i];
-            if x > later_max {
-                survivors[k] = i as u8;
-                k += 1;
-                later_max = x;
-            }
+        if let Some(last) = self.steps.last_mut() {
+            last.t_next = t[kept.trailing_zeros() as usize];
         }
-        if let Some(top) = self.steps.last_mut() {
-            top.t_next = t[0];
-        }
-        while self.steps.last().is_some_and(|s| s.rep <= later_max) {
+        while self.steps.last().is_some_and(|s| s.rep <= top) {
             self.steps.pop();
         }
-        self.steps.extend(survivors[..k].iter().rev().map(|&i| {
-            let i = usize::from(i);
-            let x = sign * v[i];
+        self.steps.extend(bits(survivors).map(|i| {
+            // the next kept instant after i, if in this block
+            let later = kept & (u64::MAX << i << 1);
+            let x = v(i);
             Step {
                 t: t[i],
-                t_next: t.get(i + 1).copied().unwrap_or(f64::NAN),
+                t_next: if later == 0 {
+                    f64::NAN
+                } else {
+                    t[later.trailing_zeros() as usize]
+                },
                 rep: x,
                 lo: x,
             }
         }));
     }
 
-    /// Merge adjacent pairs whose merged range is at most the median range (each entry in
-    /// at most one merge): frees at least ~1/6 of the stack, O(cap).
     #[cold]
     fn compact(&mut self) {
         let n = self.steps.len();
@@ -226,8 +224,64 @@ impl Staircase {
     }
 }
 
-/// Values a track holds back before it pushes them to its staircases together.
+/// Instants the tracker holds back before it pushes them to its staircases together.
 const BLOCK: usize = 64;
+
+/// Staircases per tracker: a suffix-maxima and a suffix-minima one per parameter.
+const LANES: usize = 12;
+
+/// The positions of the set bits of `mask`, lowest first.
+fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            i
+        })
+    })
+}
+
+/// The last `n` instants, not yet in the staircases. Lane p of `v[i]` holds parameter p's
+/// value at instant i, lane 6 + p its negative (the minima staircase is the maxima one of
+/// -v); -inf where the instant is not kept, which never survives a scan nor raises a
+/// maximum.
+#[derive(Debug, Clone)]
+struct Block {
+    t: [f64; BLOCK],
+    v: [[f64; LANES]; BLOCK],
+    /// Bit i of `kept[p]`: instant i is kept for parameter p.
+    kept: [u64; 6],
+    n: usize,
+}
+
+impl Block {
+    fn new() -> Self {
+        Self {
+            t: [0.0; BLOCK],
+            v: [[0.0; LANES]; BLOCK],
+            kept: [0; 6],
+            n: 0,
+        }
+    }
+
+    /// Per lane: the instants whose value exceeds every later one (bit i) and the largest
+    /// value. One backward pass over the block for all twelve lanes at once (compare and
+    /// select per lane, no branch: the compiler keeps the lanes in vector registers).
+    #[inline]
+    fn scan(&self) -> ([u64; LANES], [f64; LANES]) {
+        let mut survivors = [0u64; LANES];
+        let mut later_max = [f64::NEG_INFINITY; LANES];
+        for i in (0..self.n).rev() {
+            let row = &self.v[i];
+            for l in 0..LANES {
+                let above = row[l] > later_max[l];
+                survivors[l] |= u64::from(above) << i;
+                later_max[l] = if above { row[l] } else { later_max[l] };
+            }
+        }
+        (survivors, later_max)
+    }
+}
 
 #[derive(Debug, Clone)]
 struct Track {
@@ -239,11 +293,6 @@ struct Track {
     last_t: f64,
     last_v: f64,
     count: u64,
-    /// Values not yet in the staircases: (t, v) of the last `held` well-conditioned
-    /// instants.
-    held_t: [f64; BLOCK],
-    held_v: [f64; BLOCK],
-    held: usize,
 }
 
 impl Track {
@@ -255,49 +304,22 @@ impl Track {
             last_t: f64::NAN,
             last_v: f64::NAN,
             count: 0,
-            held_t: [0.0; BLOCK],
-            held_v: [0.0; BLOCK],
-            held: 0,
         }
     }
 
-    /// Take (t, v) when `keep`, else nothing; written without a branch on `keep` (whether
+    /// Note (t, v) when `keep`, else nothing; written without a branch on `keep` (whether
     /// an instant is well conditioned can change from sample to sample).
     #[inline]
-    fn push_if(&mut self, t: f64, v: f64, keep: bool) {
+    fn note_if(&mut self, t: f64, v: f64, keep: bool) {
         let first = keep && self.count == 0;
         self.first_t = if first { t } else { self.first_t };
-        self.held_t[self.held] = t;
-        self.held_v[self.held] = v;
-        self.held += usize::from(keep);
         self.last_t = if keep { t } else { self.last_t };
         self.last_v = if keep { v } else { self.last_v };
         self.count += u64::from(keep);
-        if self.held == BLOCK {
-            self.flush();
-        }
-    }
-
-    /// The held values into the staircases.
-    fn flush(&mut self) {
-        let n = self.held;
-        self.max
-            .push_block(&self.held_t[..n], &self.held_v[..n], 1.0);
-        self.min
-            .push_block(&self.held_t[..n], &self.held_v[..n], -1.0);
-        self.held = 0;
-    }
-
-    /// This track with every value in its staircases.
-    fn flushed(&self) -> Self {
-        let mut t = self.clone();
-        t.flush();
-        t
     }
 
     /// The summary; the held values must have been flushed.
     fn result(&self, parameter: Parameter, tol: f64) -> ParameterConvergence {
-        debug_assert_eq!(self.held, 0);
         let resolution = self.max.resolution.max(self.min.resolution);
         if self.count == 0 {
             return ParameterConvergence {
@@ -342,6 +364,7 @@ pub struct ConvergenceTracker {
     tol: f64,
     rcond_min: f64,
     tracks: [Track; 6],
+    block: Box<Block>,
     estimates: u64,
 }
 
@@ -368,6 +391,7 @@ impl ConvergenceTracker {
             tol,
             rcond_min,
             tracks: std::array::from_fn(|_| Track::new(capacity)),
+            block: Box::new(Block::new()),
             estimates: 0,
         })
     }
@@ -398,20 +422,49 @@ impl ConvergenceTracker {
         self.estimates += 1;
         let ok = e.well_conditioned(self.rcond_min);
         let v = e.values();
-        for (i, track) in self.tracks.iter_mut().enumerate() {
-            track.push_if(e.t, v[i], ok[i / 3] && v[i].is_finite());
+        let b = &mut *self.block;
+        let i = b.n;
+        b.t[i] = e.t;
+        for (p, track) in self.tracks.iter_mut().enumerate() {
+            let keep = ok[p / 3] && v[p].is_finite();
+            track.note_if(e.t, v[p], keep);
+            b.v[i][p] = if keep { v[p] } else { f64::NEG_INFINITY };
+            b.v[i][6 + p] = if keep { -v[p] } else { f64::NEG_INFINITY };
+            b.kept[p] |= u64::from(keep) << i;
         }
+        b.n += 1;
+        if b.n == BLOCK {
+            self.flush();
+        }
+    }
+
+    /// The held instants into the staircases.
+    fn flush(&mut self) {
+        let b = &mut *self.block;
+        let (survivors, top) = b.scan();
+        for (p, track) in self.tracks.iter_mut().enumerate() {
+            for (stairs, l) in [(&mut track.max, p), (&mut track.min, 6 + p)] {
+                stairs.push_survivors(&b.t, |i| b.v[i][l], b.kept[p], survivors[l], top[l]);
+            }
+            b.kept[p] = 0;
+        }
+        b.n = 0;
+    }
+
+    /// This tracker with every instant in its staircases.
+    fn flushed(&self) -> Self {
+        let mut c = self.clone();
+        c.flush();
+        c
     }
 
     /// Entries held in the 12 staircases now (each at most the capacity): the tracker's
     /// memory is about 32 bytes times this.
     pub fn stack_entries(&self) -> usize {
-        self.tracks
+        self.flushed()
+            .tracks
             .iter()
-            .map(|t| {
-                let t = t.flushed();
-                t.max.steps.len() + t.min.steps.len()
-            })
+            .map(|t| t.max.steps.len() + t.min.steps.len())
             .sum()
     }
 
@@ -419,16 +472,13 @@ impl ConvergenceTracker {
     /// identifier does not estimate (m, a, mud, alpha).
     pub fn result(&self, p: Parameter) -> Option<ParameterConvergence> {
         let i = p.direction_index()?;
-        Some(self.tracks[i].flushed().result(p, self.tol))
+        Some(self.flushed().tracks[i].result(p, self.tol))
     }
 
     /// The summaries of all six, in [`Parameter::PER_DIRECTION`] order.
     pub fn results(&self) -> [ParameterConvergence; 6] {
-        std::array::from_fn(|i| {
-            self.tracks[i]
-                .flushed()
-                .result(Parameter::PER_DIRECTION[i], self.tol)
-        })
+        let all = self.flushed();
+        std::array::from_fn(|i| all.tracks[i].result(Parameter::PER_DIRECTION[i], self.tol))
     }
 }
 
@@ -447,42 +497,62 @@ mod tests {
             && a.resolution.to_bits() == b.resolution.to_bits()
     }
 
-    /// Blocks give the staircases of one-by-one pushes bit for bit, whether or not the
-    /// stack fills and is compacted during the run: drifting, noisy and flat sequences,
-    /// capacities below, around and far above the block size, blocks cut short.
+    /// The tracker's blocks give the staircases of one-by-one pushes of each parameter's
+    /// kept values, bit for bit, whether or not a stack fills and is compacted during the
+    /// run: drifting, noisy and flat sequences with ties, instants flagged per direction
+    /// and non-finite values, capacities below, around and far above the block size, and
+    /// blocks cut short by a summary taken mid-block.
     #[test]
     fn blocks_are_one_by_one_pushes() {
+        use super::super::estimate::DirectionEstimate;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
-        for case in 0..300 {
+        for case in 0..200 {
             let cap = [2, 5, 63, 64, 65, 70, 130, 300, 4096][case % 9];
             let n = rng.gen_range(1..3000);
             let drift = [-1.0, 0.0, 1.0][case % 3] * 1e-3;
             let noise = [0.0, 1e-4, 1.0][(case / 3) % 3];
-            let values: Vec<f64> = (0..n)
-                .map(|i| {
-                    let v: f64 = rng.gen_range(-1.0..1.0);
-                    // a few repeated values, so that ties are exercised
-                    let v = if rng.gen_range(0..8) == 0 { 0.5 } else { v };
-                    drift * i as f64 + noise * v
-                })
-                .collect();
-            let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-4).collect();
-            for sign in [1.0, -1.0] {
-                let mut one = Staircase::new(cap);
-                for (&t, &v) in t.iter().zip(&values) {
-                    one.push(t, sign * v);
+            let flagged = [0.0, 0.1, 0.9][(case / 9) % 3];
+            let value = |i: usize, rng: &mut rand_chacha::ChaCha8Rng| {
+                let v: f64 = rng.gen_range(-1.0..1.0);
+                // a few repeated values, so that ties are exercised, and a few NaN
+                match rng.gen_range(0..64) {
+                    0..=7 => 0.5,
+                    8 => f64::NAN,
+                    _ => drift * i as f64 + noise * v,
                 }
-                let mut blocks = Staircase::new(cap);
-                let mut at = 0;
-                while at < n {
-                    let len = rng.gen_range(1..=BLOCK).min(n - at);
-                    blocks.push_block(&t[at..at + len], &values[at..at + len], sign);
-                    at += len;
+            };
+            let mut tracker = ConvergenceTracker::with_capacity(0.01, 0.5, cap).unwrap();
+            let mut one: [[Staircase; 2]; 6] =
+                std::array::from_fn(|_| [Staircase::new(cap), Staircase::new(cap)]);
+            for i in 0..n {
+                let dir = |rng: &mut rand_chacha::ChaCha8Rng| DirectionEstimate {
+                    m: value(i, rng),
+                    c: value(i, rng),
+                    k: value(i, rng),
+                    rcond: if rng.gen_bool(flagged) { 0.1 } else { 0.9 },
+                };
+                let e = AlgebraicEstimate {
+                    t: i as f64 * 1e-4,
+                    x: dir(&mut rng),
+                    z: dir(&mut rng),
+                };
+                tracker.push(&e);
+                let ok = e.well_conditioned(0.5);
+                for (p, v) in e.values().into_iter().enumerate() {
+                    if ok[p / 3] && v.is_finite() {
+                        one[p][0].push(e.t, v);
+                        one[p][1].push(e.t, -v);
+                    }
                 }
-                assert!(
-                    same(&one, &blocks),
-                    "case {case}: cap {cap}, n {n}, sign {sign}"
-                );
+                if rng.gen_range(0..500) == 0 || i == n - 1 {
+                    let all = tracker.flushed();
+                    for (p, [max, min]) in one.iter().enumerate() {
+                        assert!(
+                            same(max, &all.tracks[p].max) && same(min, &all.tracks[p].min),
+                            "case {case}: cap {cap}, n {n}, parameter {p}, instant {i}"
+                        );
+                    }
+                }
             }
         }
     }
