@@ -94,14 +94,20 @@ impl TimeGrid {
         if deviation <= allowed {
             Ok(())
         } else {
-            Err(PipelineError::NonUniformSampling {
-                index: i,
-                t,
-                deviation,
-                dt: self.dt,
-                tolerance,
-            })
+            Err(off_grid(i, t, deviation, self.dt, tolerance))
         }
+    }
+}
+
+/// The error of stamp `t` of sample `index`, `deviation` \[s\] off a grid of period `dt`.
+#[cold]
+fn off_grid(index: usize, t: f64, deviation: f64, dt: f64, tolerance: f64) -> PipelineError {
+    PipelineError::NonUniformSampling {
+        index,
+        t,
+        deviation,
+        dt,
+        tolerance,
     }
 }
 
@@ -228,22 +234,35 @@ impl RunningGrid {
         })
     }
 
-    /// The same least-squares fit as [`fit`](Self::fit), written with two divisions
-    /// instead of four, for checking each stamp of a stream against as it arrives:
-    /// `dt = (n S_iu - S_i S_u) / (n^2 (n^2 - 1) / 12)` (the denominator is n S_ii - S_i^2
-    /// in closed form), `t0 = t_first + (S_u - dt S_i) / n`. It may differ from `fit`
-    /// in the last bits.
-    #[inline]
-    pub fn check_fit(&self) -> Option<TimeGrid> {
+    /// The newest stamp checked against the least-squares fit of every stamp so far
+    /// (what a stream checks each stamp against): its deviation |t - (t0 + (n - 1) dt)|
+    /// \[s\] when within `tolerance dt` (plus 8 ulp of t), `None` before two stamps.
+    /// The fit is [`fit`](Self::fit)'s to rounding, written so that its two divisions do
+    /// not wait for each other: `dt = (n S_iu - S_i S_u) / (n^2 (n^2 - 1) / 12)` (the
+    /// denominator is n S_ii - S_i^2 in closed form) and, as S_i = n (n - 1) / 2,
+    /// `t0 + (n - 1) dt = t_first + S_u / n + dt (n - 1) / 2`.
+    #[inline(always)]
+    pub fn check_newest(&self, tolerance: f64) -> Result<Option<f64>, PipelineError> {
         if self.n < 2 {
-            return None;
+            return Ok(None);
         }
         let n = self.n as f64;
         let s_i = n * (n - 1.0) * 0.5;
         let (s_u, s_iu) = (self.s_u.value(), self.s_iu.value());
         let n2 = n * n;
         let dt = (n * s_iu - s_i * s_u) / (n2 * (n2 - 1.0) * (1.0 / 12.0));
-        self.grid_with(dt, s_i, s_u)
+        if !(dt.is_finite() && dt > 0.0) {
+            return Ok(None);
+        }
+        let expected = self.first + (s_u / n + dt * ((n - 1.0) * 0.5));
+        let t = self.last;
+        let deviation = (t - expected).abs();
+        let allowed = tolerance * dt + 8.0 * f64::EPSILON * t.abs().max(expected.abs());
+        if deviation <= allowed {
+            Ok(Some(deviation))
+        } else {
+            Err(off_grid(self.n - 1, t, deviation, dt, tolerance))
+        }
     }
 
     /// The fitted grid (snapped, module doc), `None` before two stamps; `max_deviation`
@@ -321,10 +340,11 @@ mod tests {
         assert!(((t[1] - t[0]) - dt).abs() > 1e-3 * dt);
     }
 
-    /// The two-division fit a stream checks against is the fit, to rounding, from two
-    /// stamps to a million, with exact, jittered and offset stamps.
+    /// The stream's check of the newest stamp measures its deviation from the fit, to
+    /// rounding, from two stamps to a million, with exact, jittered and offset stamps
+    /// (a Unix time base among them).
     #[test]
-    fn the_check_fit_is_the_fit() {
+    fn the_newest_stamp_is_checked_against_the_fit() {
         for (t0, dt, jitter) in [
             (0.0, 1e-4, 0.0),
             (1.7e9, 3.90625e-5, 0.0),
@@ -333,14 +353,31 @@ mod tests {
             let mut g = RunningGrid::default();
             for i in 0..1_000_000usize {
                 let wobble = jitter * dt * ((i as f64 * 0.37).sin());
-                g.push(i, t0 + i as f64 * dt + wobble).unwrap();
+                let t = t0 + i as f64 * dt + wobble;
+                g.push(i, t).unwrap();
                 if i >= 1 && (i.is_power_of_two() || i % 99_991 == 0) {
-                    let (a, b) = (g.fit().unwrap(), g.check_fit().unwrap());
-                    assert!((a.dt - b.dt).abs() <= 1e-12 * a.dt, "{i}: {a:?} {b:?}");
-                    assert!((a.t0 - b.t0).abs() <= 1e-9 * a.dt, "{i}: {a:?} {b:?}");
+                    let fit = g.fit().unwrap();
+                    let exact = (t - fit.time(i)).abs();
+                    let d = g.check_newest(0.5).unwrap().unwrap();
+                    // within rounding of the stamps' size (ulp(1.7e9) = 2.4e-7 s)
+                    let ulp = 4.0 * f64::EPSILON * t.abs();
+                    assert!((d - exact).abs() <= 1e-9 * dt + ulp, "{i}: {d} {exact}");
                 }
             }
+            // a stamp half a period off is refused, with its index and deviation
+            let i = g.len();
+            g.push(i, t0 + (i as f64 + 0.5) * dt).unwrap();
+            match g.check_newest(1e-3) {
+                Err(PipelineError::NonUniformSampling {
+                    index, deviation, ..
+                }) => {
+                    assert_eq!(index, i);
+                    assert!((deviation - 0.5 * dt).abs() < 1e-3 * dt, "{deviation}");
+                }
+                other => panic!("{other:?}"),
+            }
         }
+        assert_eq!(RunningGrid::default().check_newest(0.0).unwrap(), None);
     }
 
     #[test]

@@ -332,13 +332,15 @@ impl Session {
             Some(t) => {
                 self.running.push(index, t)?;
                 // Check against the given grid, or the fit of every stamp so far.
-                let reference = match self.timing {
-                    Timing::Grid { grid, .. } => Some(grid),
-                    Timing::Fit { .. } => self.running.check_fit(),
+                let deviation = match self.timing {
+                    Timing::Grid { grid, .. } => {
+                        grid.check(index, t, tolerance)?;
+                        Some((t - grid.time(index)).abs())
+                    }
+                    Timing::Fit { .. } => self.running.check_newest(tolerance)?,
                 };
-                if let Some(g) = reference {
-                    g.check(index, t, tolerance)?;
-                    self.max_deviation = self.max_deviation.max((t - g.time(index)).abs());
+                if let Some(d) = deviation {
+                    self.max_deviation = self.max_deviation.max(d);
                 }
                 t
             }
