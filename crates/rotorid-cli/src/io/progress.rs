@@ -14,8 +14,32 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-/// Nothing is shown before a run has taken this long.
+/// Nothing is shown before a run has taken this long (unless [`FIRST_REPORT_ENV`] says
+/// otherwise).
 pub const FIRST_REPORT_AFTER: Duration = Duration::from_secs(2);
+
+/// Environment variable that replaces [`FIRST_REPORT_AFTER`]: seconds, a finite number
+/// >= 0 (0: report from the first look at the clock). Any other value is refused with a
+/// warning and the default kept.
+pub const FIRST_REPORT_ENV: &str = "ROTORID_PROGRESS_AFTER_S";
+
+/// [`FIRST_REPORT_AFTER`], or what [`FIRST_REPORT_ENV`] sets.
+fn first_report_after() -> Duration {
+    let Some(v) = std::env::var_os(FIRST_REPORT_ENV) else {
+        return FIRST_REPORT_AFTER;
+    };
+    match v.to_str().and_then(|s| s.trim().parse::<f64>().ok()) {
+        Some(s) if s.is_finite() && s >= 0.0 => Duration::from_secs_f64(s),
+        _ => {
+            eprintln!(
+                "warning: {FIRST_REPORT_ENV}={v:?} is not a number of seconds >= 0; progress \
+                 is shown after the default {} s",
+                FIRST_REPORT_AFTER.as_secs()
+            );
+            FIRST_REPORT_AFTER
+        }
+    }
+}
 
 /// Without a terminal, at most this long between two lines.
 pub const LINE_INTERVAL: Duration = Duration::from_secs(10);
@@ -39,6 +63,7 @@ pub struct Progress {
     what: String,
     total: u64,
     terminal: bool,
+    first_after: Duration,
     start: Instant,
     next_check: u64,
     shown: Shown,
@@ -47,7 +72,9 @@ pub struct Progress {
 impl Progress {
     /// Progress of `total` steps labelled `what` (e.g. `simulate (exact)`).
     pub fn new(total: u64, what: &str) -> Self {
-        Self::with_terminal(total, what, std::io::stderr().is_terminal())
+        let mut p = Self::with_terminal(total, what, std::io::stderr().is_terminal());
+        p.first_after = first_report_after();
+        p
     }
 
     fn with_terminal(total: u64, what: &str, terminal: bool) -> Self {
@@ -55,6 +82,7 @@ impl Progress {
             what: what.to_owned(),
             total: total.max(1),
             terminal,
+            first_after: FIRST_REPORT_AFTER,
             start: Instant::now(),
             next_check: CHECK_STRIDE,
             shown: Shown::Nothing,
@@ -77,7 +105,7 @@ impl Progress {
         let elapsed = now.saturating_duration_since(self.start);
         let tenth = done.min(self.total) * 10 / self.total;
         match &mut self.shown {
-            Shown::Nothing if elapsed < FIRST_REPORT_AFTER => None,
+            Shown::Nothing if elapsed < self.first_after => None,
             Shown::Nothing if self.terminal => {
                 self.shown = Shown::Bar(bar(self.total, &self.what, done));
                 None
