@@ -18,9 +18,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 /// otherwise).
 pub const FIRST_REPORT_AFTER: Duration = Duration::from_secs(2);
 
-/// Environment variable that replaces [`FIRST_REPORT_AFTER`]: seconds, a finite number
-/// >= 0 (0: report from the first look at the clock). Any other value is refused with a
-/// warning and the default kept.
+/// Environment variable that replaces [`FIRST_REPORT_AFTER`]: a finite, non-negative
+/// number of seconds (0: report from the first look at the clock). Any other value is
+/// refused with a warning and the default kept.
 pub const FIRST_REPORT_ENV: &str = "ROTORID_PROGRESS_AFTER_S";
 
 /// [`FIRST_REPORT_AFTER`], or what [`FIRST_REPORT_ENV`] sets.
