@@ -85,17 +85,31 @@ impl TimeGrid {
         self.t0 + i as f64 * self.dt
     }
 
-    /// `Ok` when stamp `t` of sample `i` is within `tolerance dt` (plus 8 ulp of t) of
-    /// the grid.
-    pub fn check(&self, i: usize, t: f64, tolerance: f64) -> Result<(), PipelineError> {
-        let expected = self.time(i);
-        let deviation = (t - expected).abs();
-        let allowed = tolerance * self.dt + 8.0 * f64::EPSILON * t.abs().max(expected.abs());
-        if deviation <= allowed {
-            Ok(())
-        } else {
-            Err(off_grid(i, t, deviation, self.dt, tolerance))
-        }
+    /// Stamp `t` of sample `i` against the grid: its deviation \[s\] when within
+    /// `tolerance dt` (plus 8 ulp of t) of t0 + i dt, else the error naming the sample.
+    #[inline]
+    pub fn check(&self, i: usize, t: f64, tolerance: f64) -> Result<f64, PipelineError> {
+        within(i, t, self.time(i), self.dt, tolerance)
+    }
+}
+
+/// The deviation |t - expected| \[s\] of stamp `t` of sample `index` when it is within
+/// `tolerance dt` plus 8 ulp of the larger of t and `expected`, else the error naming the
+/// sample: the one test of both [`TimeGrid::check`] and [`RunningGrid::check_newest`].
+#[inline(always)]
+fn within(
+    index: usize,
+    t: f64,
+    expected: f64,
+    dt: f64,
+    tolerance: f64,
+) -> Result<f64, PipelineError> {
+    let deviation = (t - expected).abs();
+    let allowed = tolerance * dt + 8.0 * f64::EPSILON * t.abs().max(expected.abs());
+    if deviation <= allowed {
+        Ok(deviation)
+    } else {
+        Err(off_grid(index, t, deviation, dt, tolerance))
     }
 }
 
@@ -255,14 +269,7 @@ impl RunningGrid {
             return Ok(None);
         }
         let expected = self.first + (s_u / n + dt * ((n - 1.0) * 0.5));
-        let t = self.last;
-        let deviation = (t - expected).abs();
-        let allowed = tolerance * dt + 8.0 * f64::EPSILON * t.abs().max(expected.abs());
-        if deviation <= allowed {
-            Ok(Some(deviation))
-        } else {
-            Err(off_grid(self.n - 1, t, deviation, dt, tolerance))
-        }
+        within(self.n - 1, self.last, expected, dt, tolerance).map(Some)
     }
 
     /// The fitted grid (snapped, module doc), `None` before two stamps; `max_deviation`

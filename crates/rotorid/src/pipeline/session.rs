@@ -333,10 +333,7 @@ impl Session {
                 self.running.push(index, t)?;
                 // Check against the given grid, or the fit of every stamp so far.
                 let deviation = match self.timing {
-                    Timing::Grid { grid, .. } => {
-                        grid.check(index, t, tolerance)?;
-                        Some((t - grid.time(index)).abs())
-                    }
+                    Timing::Grid { grid, .. } => Some(grid.check(index, t, tolerance)?),
                     Timing::Fit { .. } => self.running.check_newest(tolerance)?,
                 };
                 if let Some(d) = deviation {

@@ -250,6 +250,68 @@ fn a_stream_whose_first_stamps_mislead_is_warned() {
 }
 
 #[test]
+fn stamps_on_a_given_grid_report_their_largest_deviation_and_refuse_one_too_far() {
+    // Stamps jittered by up to 0.3 dt about a given grid: the summary's deviation is the
+    // largest |t_i - (t0 + i dt)|, computed here directly; a stamp 0.5 dt off with a
+    // tolerance of 0.4 is refused with its index, and the samples before it were taken.
+    let model = table1();
+    let r = &model.response;
+    let (t0, dt) = (r.t[0], r.t[1] - r.t[0]);
+    let jitter = |i: usize| 0.3 * dt * ((i as f64) * 0.7).sin();
+    let timing = || Timing::Grid {
+        grid: rotorid::pipeline::TimeGrid::given(t0, dt).unwrap(),
+        tolerance: 0.4,
+    };
+    let sample = |i: usize, t: f64| Sample {
+        t: Some(t),
+        x: r.x[i],
+        z: r.z[i],
+        speed: None,
+    };
+    let mut s = Session::new(
+        &model.knowledge(),
+        &Method::algebraic(),
+        Some(model.scenario.speed),
+        timing(),
+    )
+    .unwrap();
+    let mut worst = 0.0_f64;
+    for i in 0..r.t.len() {
+        let t = t0 + i as f64 * dt + jitter(i);
+        worst = worst.max((t - (t0 + i as f64 * dt)).abs());
+        s.push(&sample(i, t), &mut |_| {}).unwrap();
+    }
+    let id = s.finish(&mut |_| {}).unwrap();
+    assert_eq!(id.record.max_time_deviation_s, worst);
+    assert!(worst > 0.29 * dt, "{worst}");
+    assert_eq!(id.record.grid_fitted_over, 0);
+
+    let mut s = Session::new(
+        &model.knowledge(),
+        &Method::algebraic(),
+        Some(model.scenario.speed),
+        timing(),
+    )
+    .unwrap();
+    for i in 0..7 {
+        s.push(&sample(i, t0 + i as f64 * dt), &mut |_| {}).unwrap();
+    }
+    match s.push(&sample(7, t0 + 7.5 * dt), &mut |_| {}) {
+        Err(PipelineError::NonUniformSampling {
+            index,
+            deviation,
+            tolerance,
+            ..
+        }) => {
+            assert_eq!(index, 7);
+            assert!((deviation / dt - 0.5).abs() < 1e-9, "{deviation}");
+            assert_eq!(tolerance, 0.4);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
 fn too_short_records_name_what_they_need() {
     let model = table1();
     let r = &model.response;
