@@ -13,7 +13,7 @@
 //! channel, the time axis a format implies (TDMS `wf_increment`, a UFF58 abscissa) gives
 //! t_i = start + i * increment. Channels in SI are passed through bit for bit.
 
-use crate::table::{Channel, Table};
+use crate::table::{Table, TimeAxis};
 use crate::units::{conversion, Conversion, Quantity, UnitError};
 
 /// The roles, in the order `--columns` lists them.
@@ -192,12 +192,64 @@ pub struct Used {
 }
 
 /// The channels of `table` that play the roles of `map`, checked and in SI (module doc).
-pub fn select(table: &Table, map: &ColumnMap) -> Result<SiColumns, SelectError> {
+///
+/// The table is taken by value: each channel used is moved out of it and converted in
+/// place, so the result holds the samples once (a channel that plays two roles is copied
+/// for the first). Every check runs before anything is moved.
+pub fn select(mut table: Table, map: &ColumnMap) -> Result<SiColumns, SelectError> {
+    let plan = plan(&table, map)?;
+    let mut uses = vec![0_usize; table.channels.len()];
+    for &(_, i, _) in &plan.order {
+        uses[i] += 1;
+    }
+    let mut out: [Vec<f64>; 6] = Default::default();
+    let mut used = Vec::with_capacity(plan.order.len());
+    for &(role, i, conv) in &plan.order {
+        let c = &mut table.channels[i];
+        uses[i] -= 1;
+        let mut data = if uses[i] == 0 {
+            std::mem::take(&mut c.data)
+        } else {
+            c.data.clone()
+        };
+        conv.apply_all(&mut data);
+        out[role] = data;
+        used.push(Used {
+            role: ROLES[role],
+            channel: c.name.clone(),
+            conversion: conv,
+        });
+    }
+    let [t, x, z, phi, phi_dot, phi_ddot] = out;
+    Ok(SiColumns {
+        t: match plan.axis {
+            Some((axis, n)) => axis.times(n),
+            None => t,
+        },
+        x,
+        z,
+        speed: plan.speed.then_some([phi, phi_dot, phi_ddot]),
+        used,
+        time_from_axis: plan.axis.is_some(),
+    })
+}
+
+/// What [`select`] takes from a table, checked: (role, channel index, conversion to SI) in
+/// the order the channels are used (x, z, t, phi, phi_dot, phi_ddot), the time axis and
+/// length when t comes from it, and whether the speed channels are there.
+struct Plan {
+    order: Vec<(usize, usize, Conversion)>,
+    axis: Option<(TimeAxis, usize)>,
+    speed: bool,
+}
+
+/// Every check of [`select`], before anything is moved.
+fn plan(table: &Table, map: &ColumnMap) -> Result<Plan, SelectError> {
     let file = table.file.as_str();
-    let find = |role: usize| -> Result<Option<&Channel>, SelectError> {
+    let find = |role: usize| -> Result<Option<usize>, SelectError> {
         let name = map.names[role].as_str();
-        if let Some(c) = table.channel(name) {
-            return Ok(Some(c));
+        if let Some(i) = table.channel_index(name) {
+            return Ok(Some(i));
         }
         let candidates: Vec<&str> = table.candidates(name).map(|c| c.name.as_str()).collect();
         if candidates.len() > 1 {
@@ -218,16 +270,18 @@ pub fn select(table: &Table, map: &ColumnMap) -> Result<SiColumns, SelectError> 
     };
     let x = find(1)?.ok_or_else(|| missing(1))?;
     let z = find(2)?.ok_or_else(|| missing(2))?;
-    let n = x.data.len();
-    let mut used = Vec::new();
-    let mut convert = |role: usize, c: &Channel| -> Result<Vec<f64>, SelectError> {
+    let reference = &table.channels[x];
+    let n = reference.data.len();
+    let mut order = Vec::with_capacity(6);
+    let mut check = |role: usize, i: usize| -> Result<(), SelectError> {
+        let c = &table.channels[i];
         if c.data.len() != n {
             return Err(SelectError::Length {
                 file: file.to_owned(),
                 channel: c.name.clone(),
                 role: ROLES[role],
                 len: c.data.len(),
-                reference: x.name.clone(),
+                reference: reference.name.clone(),
                 expected: n,
             });
         }
@@ -239,21 +293,18 @@ pub fn select(table: &Table, map: &ColumnMap) -> Result<SiColumns, SelectError> 
                 source,
             }
         })?;
-        let mut data = c.data.clone();
-        conv.apply_all(&mut data);
-        used.push(Used {
-            role: ROLES[role],
-            channel: c.name.clone(),
-            conversion: conv,
-        });
-        Ok(data)
+        order.push((role, i, conv));
+        Ok(())
     };
-    let xs = convert(1, x)?;
-    let zs = convert(2, z)?;
-    let (t, time_from_axis) = match find(0)? {
-        Some(c) => (convert(0, c)?, false),
-        None => match x.axis.or(z.axis) {
-            Some(axis) if !map.explicit || map.names[0] == ROLES[0] => (axis.times(n), true),
+    check(1, x)?;
+    check(2, z)?;
+    let axis = match find(0)? {
+        Some(i) => {
+            check(0, i)?;
+            None
+        }
+        None => match reference.axis.or(table.channels[z].axis) {
+            Some(axis) if !map.explicit || map.names[0] == ROLES[0] => Some((axis, n)),
             _ => {
                 return Err(SelectError::NoTime {
                     file: file.to_owned(),
@@ -264,8 +315,13 @@ pub fn select(table: &Table, map: &ColumnMap) -> Result<SiColumns, SelectError> 
     };
     let speed_channels = [find(3)?, find(4)?, find(5)?];
     let speed = match speed_channels {
-        [Some(p), Some(w), Some(a)] => Some([convert(3, p)?, convert(4, w)?, convert(5, a)?]),
-        [None, None, None] if !(map.explicit && map.names[3..] != ROLES[3..]) => None,
+        [Some(p), Some(w), Some(a)] => {
+            check(3, p)?;
+            check(4, w)?;
+            check(5, a)?;
+            true
+        }
+        [None, None, None] if !(map.explicit && map.names[3..] != ROLES[3..]) => false,
         _ => {
             let (found, missing): (Vec<usize>, Vec<usize>) =
                 (3..6).partition(|&r| speed_channels[r - 3].is_some());
@@ -286,14 +342,7 @@ pub fn select(table: &Table, map: &ColumnMap) -> Result<SiColumns, SelectError> 
             });
         }
     };
-    Ok(SiColumns {
-        t,
-        x: xs,
-        z: zs,
-        speed,
-        used,
-        time_from_axis,
-    })
+    Ok(Plan { order, axis, speed })
 }
 
 /// The table's channel names for a message, at most 20.
@@ -318,7 +367,7 @@ fn available(table: &Table) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::table::TimeAxis;
+    use crate::table::Channel;
 
     fn ch(name: &str, unit: Option<&str>, data: &[f64]) -> Channel {
         Channel {
@@ -345,7 +394,7 @@ mod tests {
             ch("rec.z", None, &[1e-6, 2e-6, 3e-6]),
             ch("other", None, &[9.0]),
         ]);
-        let s = select(&t, &ColumnMap::default()).unwrap();
+        let s = select(t.clone(), &ColumnMap::default()).unwrap();
         assert_eq!(s.t, vec![0.0, 1e-4, 2e-4]);
         assert_eq!(s.x, vec![1e-6, 2e-6, 3e-6]);
         // SI passes through bit for bit
@@ -353,6 +402,43 @@ mod tests {
         assert!(s.speed.is_none() && !s.time_from_axis);
         let roles: Vec<_> = s.used.iter().map(|u| (u.role, u.conversion.unit)).collect();
         assert_eq!(roles, vec![("x", "um"), ("z", "m"), ("t", "ms")]);
+    }
+
+    #[test]
+    fn the_channels_are_moved_not_copied() {
+        // the samples are held once: each column is its channel's own buffer, converted
+        // in place (t in ms here) or passed through (x, z in m)
+        let t = table(vec![
+            ch("t", Some("ms"), &[0.0, 0.1, 0.2]),
+            ch("x", None, &[1e-6, 2e-6, 3e-6]),
+            ch("z", None, &[4e-6, 5e-6, 6e-6]),
+        ]);
+        let ptrs: Vec<*const f64> = t.channels.iter().map(|c| c.data.as_ptr()).collect();
+        let s = select(t, &ColumnMap::default()).unwrap();
+        assert_eq!(
+            [s.t.as_ptr(), s.x.as_ptr(), s.z.as_ptr()],
+            [ptrs[0], ptrs[1], ptrs[2]]
+        );
+        assert_eq!(s.t, vec![0.0, 1e-4, 2e-4]);
+    }
+
+    #[test]
+    fn a_channel_that_plays_two_roles_serves_both() {
+        // x and z from one channel in um, t in ms: each role gets its own converted copy
+        let t = table(vec![
+            ch("t", Some("ms"), &[0.0, 0.1]),
+            ch("probe", Some("um"), &[1.0, 2.0]),
+        ]);
+        let s = select(t, &ColumnMap::parse("t,probe,probe").unwrap()).unwrap();
+        assert_eq!(s.x, vec![1e-6, 2e-6]);
+        assert_eq!(s.z, s.x);
+        assert_eq!(s.t, vec![0.0, 1e-4]);
+        let channels: Vec<_> = s
+            .used
+            .iter()
+            .map(|u| (u.role, u.channel.as_str()))
+            .collect();
+        assert_eq!(channels, vec![("x", "probe"), ("z", "probe"), ("t", "t")]);
     }
 
     #[test]
@@ -364,11 +450,15 @@ mod tests {
         });
         let t = table(vec![x, ch("g/probe_z", None, &[3e-6, 4e-6])]);
         let map = ColumnMap::parse("t, probe_x, probe_z").unwrap();
-        let s = select(&t, &map).unwrap();
+        let s = select(t.clone(), &map).unwrap();
         assert_eq!(s.t, vec![0.5, 0.75]);
         assert!(s.time_from_axis);
         // a time channel named explicitly must exist
-        let e = select(&t, &ColumnMap::parse("time,probe_x,probe_z").unwrap()).unwrap_err();
+        let e = select(
+            t.clone(),
+            &ColumnMap::parse("time,probe_x,probe_z").unwrap(),
+        )
+        .unwrap_err();
         assert!(matches!(e, SelectError::NoTime { .. }), "{e}");
     }
 
@@ -381,12 +471,12 @@ mod tests {
             ch("t", None, &[0.0, 1.0]),
             ch("phi", None, &[0.0, 1.0]),
         ]);
-        let e = select(&t, &ColumnMap::default()).unwrap_err();
+        let e = select(t.clone(), &ColumnMap::default()).unwrap_err();
         assert_eq!(
             e.to_string(),
             "rec.mat: \"x\" for x is ambiguous: it could be a.x, b.x; give the full name"
         );
-        let e = select(&t, &ColumnMap::parse("t,a.x,z").unwrap()).unwrap_err();
+        let e = select(t.clone(), &ColumnMap::parse("t,a.x,z").unwrap()).unwrap_err();
         assert!(
             e.to_string()
                 .starts_with("rec.mat, channel \"z\" (z): unknown unit \"furlong\""),
@@ -397,7 +487,7 @@ mod tests {
             ch("z", None, &[1.0]),
             ch("t", None, &[0.0, 1.0]),
         ]);
-        let e = select(&t2, &ColumnMap::default()).unwrap_err();
+        let e = select(t2.clone(), &ColumnMap::default()).unwrap_err();
         assert!(
             matches!(
                 e,
@@ -415,13 +505,13 @@ mod tests {
             ch("t", None, &[0.0]),
             ch("phi", None, &[0.0]),
         ]);
-        let e = select(&t3, &ColumnMap::default()).unwrap_err();
+        let e = select(t3.clone(), &ColumnMap::default()).unwrap_err();
         assert_eq!(
             e.to_string(),
             "rec.mat: has phi but not phi_dot, phi_ddot: give all of phi, phi_dot, phi_ddot \
              or none (then the scenario's speed profile is used)"
         );
-        let e = select(&t3, &ColumnMap::parse("t,x,y").unwrap()).unwrap_err();
+        let e = select(t3.clone(), &ColumnMap::parse("t,x,y").unwrap()).unwrap_err();
         assert_eq!(
             e.to_string(),
             "rec.mat: no channel \"y\" for z; the file has: x, z, t, phi"

@@ -53,12 +53,22 @@ impl Table {
     /// separator, the one channel whose last component (after `.` or `/`) is `name`.
     /// `None` when there is none or the short name is ambiguous (see [`Table::candidates`]).
     pub fn channel(&self, name: &str) -> Option<&Channel> {
-        if let Some(c) = self.channels.iter().find(|c| c.name == name) {
-            return Some(c);
+        self.channel_index(name).map(|i| &self.channels[i])
+    }
+
+    /// The index in [`Table::channels`] of the channel [`Table::channel`] finds.
+    pub fn channel_index(&self, name: &str) -> Option<usize> {
+        if let Some(i) = self.channels.iter().position(|c| c.name == name) {
+            return Some(i);
         }
-        let mut hits = self.candidates(name);
+        let mut hits = self
+            .channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| last_component(&c.name) == name)
+            .map(|(i, _)| i);
         match (hits.next(), hits.next()) {
-            (Some(c), None) => Some(c),
+            (Some(i), None) => Some(i),
             _ => None,
         }
     }

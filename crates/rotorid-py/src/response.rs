@@ -54,9 +54,10 @@ pub fn read_any(path: &str, columns: Option<&str>) -> Result<Response, Error> {
         Some(spec) => rotorid_io::ColumnMap::parse(spec)?,
         None => rotorid_io::ColumnMap::default(),
     };
-    let s = rotorid_io::select(&table, &map)?;
+    let notes = table.notes.clone();
+    let s = rotorid_io::select(table, &map)?;
     Ok(Response {
-        notes: table.notes.clone(),
+        notes,
         converted: s
             .used
             .iter()

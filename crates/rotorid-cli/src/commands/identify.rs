@@ -52,7 +52,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         (args.input.clone(), stream::Source::Columns(cols))
     } else if tables::is_tabular(&args.input, columns) {
         let table = tables::read(&args.input)?;
-        let cols = tables::columns(&table, columns)?;
+        let cols = tables::columns(table, columns)?;
         (args.input.clone(), stream::Source::Columns(cols))
     } else {
         if columns.is_some() {

@@ -156,7 +156,7 @@ pub fn run(args: PlotArgs) -> anyhow::Result<()> {
                 conditioned_figure(&title, &table, spec, acq, window, keyphasor)?
             }
             _ => {
-                let c = tables::columns(&table, None)?;
+                let c = tables::columns(table, None)?;
                 let phi = c.speed.as_ref().map(|s| s[0].as_slice());
                 let d = ResponseData::from_columns(&c.t, &c.x, &c.z, phi, window, keyphasor);
                 response_figure(&format!("{title}: response"), &d, window)?

@@ -60,7 +60,7 @@ fn read_recording(file: &str) -> anyhow::Result<(TimeGrid, Vec<Channel>)> {
     // column names) is read whole through rotorid-io, units converted to SI
     let cols = if crate::io::tables::is_tabular(file, None) {
         let table = crate::io::tables::read(file)?;
-        crate::io::tables::columns(&table, None)?
+        crate::io::tables::columns(table, None)?
     } else {
         let (name, input) = open_input(file)?;
         rotorid_io::csv::ResponseReader::new(&name, input)?.read_columns()?

@@ -39,17 +39,19 @@ pub fn read(path: &str) -> anyhow::Result<Table> {
 }
 
 /// The channels of `table` that play t, x, z and (when present) phi, phi_dot, phi_ddot, in
-/// SI; `columns` is the `--columns` text. Each converted channel is noted on stderr.
-pub fn columns(table: &Table, columns: Option<&str>) -> anyhow::Result<SiColumns> {
+/// SI; `columns` is the `--columns` text. Each converted channel is noted on stderr. The
+/// table is consumed: its channels become the columns without a copy.
+pub fn columns(table: Table, columns: Option<&str>) -> anyhow::Result<SiColumns> {
     let map = match columns {
         Some(spec) => ColumnMap::parse(spec)?,
         None => ColumnMap::default(),
     };
+    let file = table.file.clone();
     let cols = select(table, &map)?;
     for u in cols.used.iter().filter(|u| !u.conversion.is_identity()) {
         eprintln!(
             "note: {}: {} ({}) in {}, converted to {} (x {:e})",
-            table.file,
+            file,
             u.channel,
             u.role,
             u.conversion.unit,
@@ -60,7 +62,7 @@ pub fn columns(table: &Table, columns: Option<&str>) -> anyhow::Result<SiColumns
     if cols.time_from_axis {
         eprintln!(
             "note: {}: time from the file's time axis (no time channel)",
-            table.file
+            file
         );
     }
     Ok(cols)
