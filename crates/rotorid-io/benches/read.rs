@@ -18,6 +18,7 @@ const FILES: &[(&str, Format)] = &[
     ("x_compressed.mat", Format::Mat),
     ("x_v73.mat", Format::Mat),
     ("x.tdms", Format::Tdms),
+    ("x_10seg.tdms", Format::Tdms),
     ("x.uff", Format::Uff58),
     ("x_ascii.uff", Format::Uff58),
     ("x.parquet", Format::Parquet),

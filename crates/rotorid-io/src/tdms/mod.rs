@@ -189,6 +189,7 @@ fn read_from<S: Source + ?Sized>(file: &str, src: &S) -> Result<Table, ReadError
                 file,
                 start: raw_start,
                 end: seg_end,
+                size,
                 e,
                 open: next == u64::MAX,
             };
@@ -203,7 +204,9 @@ fn read_from<S: Source + ?Sized>(file: &str, src: &S) -> Result<Table, ReadError
         if objects[k].path.len() != 2 || !objects[k].numeric {
             continue;
         }
-        let data = scaled(file, &mut objects, k, root)?;
+        let mut data = scaled(file, &mut objects, k, root)?;
+        // (room reserved ahead for segments that did not come: Raw::reserve)
+        data.shrink_to_fit();
         let o = &mut objects[k];
         let name = o.name();
         let axis = match o.increment {
@@ -514,11 +517,31 @@ struct Raw<'a> {
     file: &'a str,
     start: u64,
     end: u64,
+    /// The file's size \[bytes\].
+    size: u64,
     e: Endian,
     open: bool,
 }
 
 impl Raw<'_> {
+    /// Room in a channel's `data` for the `here` values this segment holds, of
+    /// `value_bytes` bytes each in the file. On the channel's first segment, room for the
+    /// rest of the file too, as if it repeated this segment's raw data (what writers that
+    /// append a block per segment do), but never for more values than the bytes left can
+    /// hold: a channel grown segment by segment was moved and copied at each doubling (10
+    /// segments read 2x slower than one). Later segments grow it as needed; [`read_from`]
+    /// trims what was not used.
+    fn reserve(&self, data: &mut Vec<f64>, here: u64, value_bytes: u64) {
+        if data.capacity() == 0 {
+            let left = self.size - self.start;
+            let segments = left.div_ceil((self.end - self.start).max(1));
+            let most = left / value_bytes.max(1);
+            data.reserve_exact(here.saturating_mul(segments).min(most).max(here) as usize);
+        } else {
+            data.reserve(here as usize);
+        }
+    }
+
     /// `n` values of `t` of `channel` at file offset `at`, one every `stride` bytes, read
     /// from `src`; the values are numbers `first..first + n` of the channel, counted from
     /// its first value in the file over every segment and chunk (as an
@@ -601,9 +624,7 @@ fn raw_data<S: Source + ?Sized>(
     // per raw byte.
     for &(k, i) in &present {
         if i.dtype.is_some() {
-            objects[k]
-                .data
-                .reserve(i.count.saturating_mul(chunks) as usize);
+            r.reserve(&mut objects[k].data, i.count.saturating_mul(chunks), i.size);
         }
     }
     let names: Vec<String> = present.iter().map(|&(k, _)| objects[k].name()).collect();
@@ -812,10 +833,12 @@ fn interleaved_data<S: Source + ?Sized>(
     }
     let chunks = if bad.is_some() { 1 } else { chunks };
     if bad.is_none() {
-        for (k, ..) in &cols {
-            objects[*k]
-                .data
-                .reserve(count.saturating_mul(chunks) as usize);
+        for (k, _, d, _) in &cols {
+            r.reserve(
+                &mut objects[*k].data,
+                count.saturating_mul(chunks),
+                d.size() as u64,
+            );
         }
     }
     let per = (BLOCK / row.max(1)).max(1);
@@ -962,6 +985,31 @@ mod tests {
                 assert_eq!(offset, raw_start + at as u64);
             }
             other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn channels_across_segments_of_other_layouts_are_whole_and_trimmed() {
+        // a and b in a small first segment (room is reserved ahead as if the file repeated
+        // it), then b alone in a larger one (more than reserved: grown), then a alone
+        // (less than reserved: trimmed at the end)
+        let f64s = |v: &[f64]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+        let a1: Vec<f64> = (0..10).map(f64::from).collect();
+        let b1: Vec<f64> = (1000..1010).map(f64::from).collect();
+        let b2: Vec<f64> = (2000..3000).map(f64::from).collect();
+        let a3: Vec<f64> = (100..105).map(f64::from).collect();
+        let mut f = segment(
+            0,
+            &[("a", 10, 10), ("b", 10, 10)],
+            &[f64s(&a1), f64s(&b1)].concat(),
+        );
+        f.extend(segment(0, &[("b", 10, 1000)], &f64s(&b2)));
+        f.extend(segment(0, &[("a", 10, 5)], &f64s(&a3)));
+        let t = both(&f).unwrap();
+        assert_eq!(t.channels[0].data, [a1, a3].concat());
+        assert_eq!(t.channels[1].data, [b1, b2].concat());
+        for c in &t.channels {
+            assert_eq!(c.data.capacity(), c.data.len(), "{}", c.name);
         }
     }
 
