@@ -20,6 +20,11 @@
 //! guard (`crate::guard`): should the crate panic on a malformed page, the error names
 //! the column, the row group and the chunk's byte offset, as a null or an inexact integer
 //! does.
+//!
+//! The columns are decoded side by side, on as many threads as the machine offers (at most
+//! four), each column's chunks in order on one thread; a file on disk is read at offsets
+//! (`pread`), which the threads share. Of several bad columns the first in column order is
+//! the one reported, as when they are read one by one.
 
 use bytes::Bytes;
 use parquet::basic::{ConvertedType, Type as Physical};
@@ -40,12 +45,68 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 }
 
 /// Reads the Parquet file at `path` column chunk by column chunk: memory holds the channels
-/// and one column chunk (and the `parquet` crate's page buffers), never the whole file.
+/// and a column chunk per thread (and the `parquet` crate's page buffers), never the whole
+/// file.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
     let disk = crate::format::DiskFile::open(file, path)?;
-    let handle = disk.handle()?;
+    let handle = Positional {
+        f: std::sync::Arc::new(disk.handle()?),
+        size: disk.size,
+    };
     let chunk = |start: u64, len: u64| disk.read_at(start, len);
     guarded(file, || read_inner(file, handle, disk.size, &chunk))
+}
+
+/// The file read at offsets (`pread`), so that threads decoding column chunks side by side
+/// can share it: the `parquet` crate's reader of a `File` seeks one offset shared by every
+/// handle it clones.
+struct Positional {
+    f: std::sync::Arc<std::fs::File>,
+    /// Size \[bytes\].
+    size: u64,
+}
+
+impl parquet::file::reader::Length for Positional {
+    fn len(&self) -> u64 {
+        self.size
+    }
+}
+
+impl ChunkReader for Positional {
+    // (small: the crate reads a page header from here, then the page with get_bytes)
+    type T = std::io::BufReader<At>;
+
+    fn get_read(&self, start: u64) -> parquet::errors::Result<Self::T> {
+        Ok(std::io::BufReader::with_capacity(
+            HEADER_WINDOW as usize,
+            At {
+                f: std::sync::Arc::clone(&self.f),
+                pos: start,
+            },
+        ))
+    }
+
+    fn get_bytes(&self, start: u64, length: usize) -> parquet::errors::Result<Bytes> {
+        use std::os::unix::fs::FileExt as _;
+        let mut buf = vec![0u8; length];
+        self.f.read_exact_at(&mut buf, start)?;
+        Ok(buf.into())
+    }
+}
+
+/// A reader of [`Positional`]'s file from `pos` on.
+struct At {
+    f: std::sync::Arc<std::fs::File>,
+    pos: u64,
+}
+
+impl std::io::Read for At {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        use std::os::unix::fs::FileExt as _;
+        let n = self.f.read_at(buf, self.pos)?;
+        self.pos += n as u64;
+        Ok(n)
+    }
 }
 
 /// `run`, with a panic of the third-party parser on a hostile file made an error.
@@ -123,7 +184,8 @@ fn read_inner<R: ChunkReader + 'static>(
             )?;
         }
     }
-    let mut channels = Vec::new();
+    // The numeric top-level columns, and what is skipped.
+    let mut wanted = Vec::new();
     let mut skipped = Vec::new();
     for col in 0..schema.num_columns() {
         let cd = schema.column(col);
@@ -148,34 +210,63 @@ fn read_inner<R: ChunkReader + 'static>(
             ) => Some(Kind::Unsigned),
             _ => None,
         };
-        let Some(kind) = kind else {
-            skipped.push(format!(
+        match kind {
+            Some(kind) => wanted.push(Column {
+                col,
+                name,
+                kind,
+                max_def: cd.max_def_level(),
+            }),
+            None => skipped.push(format!(
                 "{name} ({} {})",
                 cd.physical_type(),
                 cd.converted_type()
-            ));
-            continue;
-        };
-        let max_def = cd.max_def_level();
-        // The declared rows, but never more values than the file has bytes: a hostile
-        // footer cannot make this allocation larger than 8 bytes per byte of the file.
-        let mut data: Vec<f64> = Vec::with_capacity((rows as u64).min(size) as usize);
-        for rg in 0..reader.num_row_groups() {
-            let cc = meta.row_group(rg).column(col);
-            let at = Chunk {
-                name: &name,
-                row_group: rg,
-                offset: cc.dictionary_page_offset().unwrap_or(cc.data_page_offset()) as u64,
-                len: cc.compressed_size() as u64,
-            };
-            // A panic of the crate in this column chunk names it (crate::guard).
-            crate::guard::quietly(|| {
-                read_chunk(file, &reader, col, kind, max_def, limit, &at, &mut data)
-            })
-            .unwrap_or_else(|| Err(at.undecodable(file)))?;
+            )),
         }
+    }
+    // The declared rows, but never more values than the file has bytes: a hostile footer
+    // cannot make a column's allocation larger than 8 bytes per byte of the file.
+    let capacity = (rows as u64).min(size) as usize;
+    let read = |c: &Column| read_column(file, &reader, c, capacity, limit);
+    // Columns side by side, each thread taking the next column not yet taken; the first
+    // error in column order is the one reported, as when they are read one by one.
+    let threads = std::thread::available_parallelism()
+        .map_or(1, std::num::NonZeroUsize::get)
+        .min(wanted.len())
+        .min(MAX_THREADS);
+    let mut results: Vec<Option<ColumnResult>> = Vec::new();
+    if threads <= 1 {
+        results.extend(wanted.iter().map(|c| Some(read(c))));
+    } else {
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let done: Vec<Vec<(usize, ColumnResult)>> = std::thread::scope(|scope| {
+            let workers: Vec<_> = (0..threads)
+                .map(|_| {
+                    scope.spawn(|| {
+                        let mut out = Vec::new();
+                        loop {
+                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                            let Some(c) = wanted.get(i) else {
+                                return out;
+                            };
+                            out.push((i, read(c)));
+                        }
+                    })
+                })
+                .collect();
+            // (read_column catches the crate's panics; a worker has no other way to panic)
+            workers.into_iter().flat_map(|w| w.join().ok()).collect()
+        });
+        results.resize_with(wanted.len(), || None);
+        for (i, r) in done.into_iter().flatten() {
+            results[i] = Some(r);
+        }
+    }
+    let mut channels = Vec::with_capacity(wanted.len());
+    for (c, r) in wanted.into_iter().zip(results) {
+        let data = r.unwrap_or_else(|| Err(err(file, Some(&c.name), "its reader failed")))?;
         channels.push(Channel {
-            name,
+            name: c.name,
             unit: None,
             data,
             axis: None,
@@ -196,6 +287,50 @@ fn read_inner<R: ChunkReader + 'static>(
         channels,
         notes: Vec::new(),
     })
+}
+
+/// A column's values, or why it could not be read.
+type ColumnResult = Result<Vec<f64>, ReadError>;
+
+/// At most this many threads decode a file's columns.
+const MAX_THREADS: usize = 4;
+
+/// A numeric top-level column to read: its index in the schema, name, how its values
+/// become `f64`, and its largest definition level (0 when it cannot hold a null).
+struct Column {
+    col: usize,
+    name: String,
+    kind: Kind,
+    max_def: i16,
+}
+
+/// Every value of column `c`, its row groups in order, into a vector of `capacity`.
+fn read_column<R: ChunkReader + 'static>(
+    file: &str,
+    reader: &SerializedFileReader<R>,
+    c: &Column,
+    capacity: usize,
+    limit: u64,
+) -> Result<Vec<f64>, ReadError> {
+    let meta = reader.metadata();
+    let mut data: Vec<f64> = Vec::with_capacity(capacity);
+    for rg in 0..reader.num_row_groups() {
+        let cc = meta.row_group(rg).column(c.col);
+        let at = Chunk {
+            name: &c.name,
+            row_group: rg,
+            offset: cc.dictionary_page_offset().unwrap_or(cc.data_page_offset()) as u64,
+            len: cc.compressed_size() as u64,
+        };
+        // A panic of the crate in this column chunk names it (crate::guard).
+        crate::guard::quietly(|| {
+            read_chunk(
+                file, reader, c.col, c.kind, c.max_def, limit, &at, &mut data,
+            )
+        })
+        .unwrap_or_else(|| Err(at.undecodable(file)))?;
+    }
+    Ok(data)
 }
 
 /// Where a column chunk lies: its column, row group and bytes (from the footer, checked
@@ -875,6 +1010,70 @@ const PAGE_HEADER: &[(i16, Ty)] = &[
 mod tests {
     use super::*;
     use std::cell::RefCell;
+
+    /// `cols` written by rotorid's own Parquet writer, read from memory and from disk (the
+    /// columns decoded side by side from one positional file), which must agree.
+    fn written_and_read(
+        cols: &[(&str, crate::write::ParquetColumn<'_>)],
+    ) -> Result<Table, ReadError> {
+        let bytes = crate::write::parquet_columns_bytes("w.parquet", cols).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("w.parquet");
+        std::fs::write(&path, &bytes).unwrap();
+        let mem = read("w.parquet", &bytes);
+        let disk = read_file("w.parquet", &path);
+        assert_eq!(format!("{mem:?}"), format!("{disk:?}"));
+        disk
+    }
+
+    #[test]
+    fn columns_read_side_by_side_are_the_columns_written_in_order() {
+        use crate::write::ParquetColumn::Required;
+        let data: Vec<Vec<f64>> = (0..9)
+            .map(|k| {
+                (0..5000)
+                    .map(|i| f64::from(i) * 0.25 + f64::from(k) * 1e4)
+                    .collect()
+            })
+            .collect();
+        let names: Vec<String> = (0..9).map(|k| format!("c{k}")).collect();
+        let cols: Vec<_> = names
+            .iter()
+            .zip(&data)
+            .map(|(n, d)| (n.as_str(), Required(d)))
+            .collect();
+        let t = written_and_read(&cols).unwrap();
+        assert_eq!(t.channels.len(), 9);
+        for (c, (n, d)) in t.channels.iter().zip(names.iter().zip(&data)) {
+            assert_eq!((&c.name, &c.data), (n, d));
+        }
+    }
+
+    #[test]
+    fn of_two_bad_columns_the_first_is_named_whichever_thread_finishes_first() {
+        use crate::write::ParquetColumn::{Optional, Required};
+        let ok: Vec<f64> = (0..3000).map(f64::from).collect();
+        let hole = |at: usize| -> Vec<Option<f64>> {
+            (0..3000).map(|i| (i != at).then_some(i as f64)).collect()
+        };
+        // b's null is late in a long column, d's early: d's reader fails first
+        let (b, d) = (hole(2900), hole(1));
+        let cols = [
+            ("a", Required(&ok)),
+            ("b", Optional(&b)),
+            ("c", Required(&ok)),
+            ("d", Optional(&d)),
+        ];
+        for _ in 0..20 {
+            match written_and_read(&cols) {
+                Err(ReadError::Invalid { channel, what, .. }) => {
+                    assert_eq!(channel.as_deref(), Some("b"));
+                    assert!(what.starts_with("row 2900 of row group 0"), "{what}");
+                }
+                other => panic!("{other:?}"),
+            }
+        }
+    }
 
     /// A compact-protocol page header: type DATA_PAGE, the two sizes, and (when `pad` > 0)
     /// an unknown binary field 20 of `pad` bytes, which the walk steps over.
