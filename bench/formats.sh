@@ -12,30 +12,16 @@
 # Needs the release binary (built here), farm-bench (the tool library), and Python 3 (a
 # venv with the reference tools is made under target/formats-venv from PyPI). Files go to
 # target/bench-data.
-set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/.."
 runs="${1:-11}"
-target="${CARGO_TARGET_DIR:-$PWD/target}"
-data="$target/bench-data"
-venv="$target/formats-venv"
-mkdir -p "$data"
-
-cargo build --release -q -p rotorid-cli
-rotorid="$target/release/rotorid"
-if [ ! -x "$venv/bin/python" ]; then
-  python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check numpy scipy h5py npTDMS pyarrow pyuff
-fi
-for ext in csv npz; do
-  if [ ! -s "$data/table1_100s.$ext" ]; then
-    "$rotorid" simulate --scenario table1 --duration 100 --out "$data/table1_100s.$ext"
-  fi
-done
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+py=$(venv formats-venv numpy scipy h5py npTDMS pyarrow pyuff)
+record csv >/dev/null
+npz=$(record npz)
 if [ ! -s "$data/formats/rec_58b.uff" ]; then
-  "$venv/bin/python" bench/formats.py "$data/table1_100s.npz" "$data/formats"
+  "$py" bench/formats.py "$npz" "$data/formats"
 fi
 
-"$venv/bin/python" - "$runs" "$rotorid" "$data" <<'PY'
+"$py" - "$runs" "$rotorid" "$data" <<'PY'
 import os, re, subprocess, sys
 runs, rotorid, data = sys.argv[1], sys.argv[2], sys.argv[3]
 csv = f"{data}/table1_100s.csv"

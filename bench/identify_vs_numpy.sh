@@ -11,26 +11,10 @@
 #
 # Needs the release binary (built here) and Python 3 with numpy and pandas (a venv is made
 # under target/bench-venv from PyPI). Files go to target/bench-data.
-set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/.."
 runs="${1:-5}"
-target="${CARGO_TARGET_DIR:-$PWD/target}"
-data="$target/bench-data"
-venv="$target/bench-venv"
-mkdir -p "$data"
-
-cargo build --release -q -p rotorid-cli
-rotorid="$target/release/rotorid"
-if [ ! -x "$venv/bin/python" ]; then
-  python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check "numpy>=1.26,<3" "pandas>=2.0,<4"
-fi
-py="$venv/bin/python"
-
-csv="$data/table1_100s.csv"
-if [ ! -s "$csv" ]; then
-  "$rotorid" simulate --scenario table1 --duration 100 --out "$csv"
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+py=$(venv bench-venv "numpy>=1.26,<3" "pandas>=2.0,<4")
+csv=$(record csv)
 
 "$py" - "$runs" "$rotorid" "$py" "$csv" "$data" <<'EOF'
 import statistics, subprocess, sys, time

@@ -38,23 +38,39 @@ const BATCH: usize = 65_536;
 
 /// Reads a Parquet file's bytes; `file` names it in messages.
 pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
+    read_with(file, bytes, PARALLEL_FROM)
+}
+
+/// [`read`], its columns side by side from `parallel_from` bytes on ([`read_inner`]).
+fn read_with(file: &str, bytes: &[u8], parallel_from: u64) -> Result<Table, ReadError> {
     let data = Bytes::copy_from_slice(bytes);
     let size = bytes.len() as u64;
     let chunk = |start: u64, len: u64| Ok(bytes[start as usize..(start + len) as usize].to_vec());
-    guarded(file, || read_inner(file, data, size, &chunk))
+    guarded(file, || read_inner(file, data, size, &chunk, parallel_from))
 }
 
 /// Reads the Parquet file at `path` column chunk by column chunk: memory holds the channels
 /// and a column chunk per thread (and the `parquet` crate's page buffers), never the whole
 /// file.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
+    read_file_with(file, path, PARALLEL_FROM)
+}
+
+/// [`read_file`], its columns side by side from `parallel_from` bytes on ([`read_inner`]).
+fn read_file_with(
+    file: &str,
+    path: &std::path::Path,
+    parallel_from: u64,
+) -> Result<Table, ReadError> {
     let disk = crate::format::DiskFile::open(file, path)?;
     let handle = Positional {
         f: std::sync::Arc::new(disk.handle()?),
         size: disk.size,
     };
     let chunk = |start: u64, len: u64| disk.read_at(start, len);
-    guarded(file, || read_inner(file, handle, disk.size, &chunk))
+    guarded(file, || {
+        read_inner(file, handle, disk.size, &chunk, parallel_from)
+    })
 }
 
 /// The file read at offsets (`pread`), so that threads decoding column chunks side by side
@@ -143,12 +159,14 @@ enum Kind {
 type ChunkFn<'a> = dyn Fn(u64, u64) -> Result<Vec<u8>, ReadError> + 'a;
 
 /// The table of a Parquet file of `size` bytes, read through `source`; `chunk` gives a
-/// column chunk's bytes for [`check_pages`].
+/// column chunk's bytes for [`check_pages`]. The columns are decoded side by side when
+/// their chunks hold `parallel_from` bytes or more together.
 fn read_inner<R: ChunkReader + 'static>(
     file: &str,
     source: R,
     size: u64,
     chunk: &ChunkFn<'_>,
+    parallel_from: u64,
 ) -> Result<Table, ReadError> {
     let footer = check_footer(file, size, chunk)?;
     let reader = SerializedFileReader::new(source).map_err(|e| err(file, None, e))?;
@@ -230,10 +248,19 @@ fn read_inner<R: ChunkReader + 'static>(
     let read = |c: &Column| read_column(file, &reader, c, capacity, limit);
     // Columns side by side, each thread taking the next column not yet taken; the first
     // error in column order is the one reported, as when they are read one by one.
-    let threads = std::thread::available_parallelism()
-        .map_or(1, std::num::NonZeroUsize::get)
-        .min(wanted.len())
-        .min(MAX_THREADS);
+    let bytes: u64 = wanted
+        .iter()
+        .flat_map(|c| meta.row_groups().iter().map(|g| g.column(c.col)))
+        .map(|cc| cc.compressed_size().max(0) as u64)
+        .fold(0, u64::saturating_add);
+    let threads = if bytes < parallel_from {
+        1
+    } else {
+        std::thread::available_parallelism()
+            .map_or(1, std::num::NonZeroUsize::get)
+            .min(wanted.len())
+            .min(MAX_THREADS)
+    };
     let mut results: Vec<Option<ColumnResult>> = Vec::new();
     if threads <= 1 {
         results.extend(wanted.iter().map(|c| Some(read(c))));
@@ -294,6 +321,10 @@ type ColumnResult = Result<Vec<f64>, ReadError>;
 
 /// At most this many threads decode a file's columns.
 const MAX_THREADS: usize = 4;
+
+/// Columns whose chunks hold fewer bytes than this together are read one by one: starting
+/// threads would cost more than it saves.
+const PARALLEL_FROM: u64 = 1 << 20;
 
 /// A numeric top-level column to read: its index in the schema, name, how its values
 /// become `f64`, and its largest definition level (0 when it cannot hold a null).
@@ -1011,8 +1042,9 @@ mod tests {
     use super::*;
     use std::cell::RefCell;
 
-    /// `cols` written by rotorid's own Parquet writer, read from memory and from disk (the
-    /// columns decoded side by side from one positional file), which must agree.
+    /// `cols` written by rotorid's own Parquet writer, read from memory one column after
+    /// another and from disk side by side (threads sharing one positional file), which must
+    /// agree.
     fn written_and_read(
         cols: &[(&str, crate::write::ParquetColumn<'_>)],
     ) -> Result<Table, ReadError> {
@@ -1020,8 +1052,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("w.parquet");
         std::fs::write(&path, &bytes).unwrap();
-        let mem = read("w.parquet", &bytes);
-        let disk = read_file("w.parquet", &path);
+        let mem = read_with("w.parquet", &bytes, u64::MAX);
+        let disk = read_file_with("w.parquet", &path, 0);
         assert_eq!(format!("{mem:?}"), format!("{disk:?}"));
         disk
     }

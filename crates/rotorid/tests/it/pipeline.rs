@@ -258,9 +258,18 @@ fn stamps_on_a_given_grid_report_their_largest_deviation_and_refuse_one_too_far(
     let r = &model.response;
     let (t0, dt) = (r.t[0], r.t[1] - r.t[0]);
     let jitter = |i: usize| 0.3 * dt * ((i as f64) * 0.7).sin();
-    let timing = || Timing::Grid {
-        grid: rotorid::pipeline::TimeGrid::given(t0, dt).unwrap(),
-        tolerance: 0.4,
+    let session = || {
+        let timing = Timing::Grid {
+            grid: rotorid::pipeline::TimeGrid::given(t0, dt).unwrap(),
+            tolerance: 0.4,
+        };
+        Session::new(
+            &model.knowledge(),
+            &Method::algebraic(),
+            Some(model.scenario.speed),
+            timing,
+        )
+        .unwrap()
     };
     let sample = |i: usize, t: f64| Sample {
         t: Some(t),
@@ -268,13 +277,7 @@ fn stamps_on_a_given_grid_report_their_largest_deviation_and_refuse_one_too_far(
         z: r.z[i],
         speed: None,
     };
-    let mut s = Session::new(
-        &model.knowledge(),
-        &Method::algebraic(),
-        Some(model.scenario.speed),
-        timing(),
-    )
-    .unwrap();
+    let mut s = session();
     let mut worst = 0.0_f64;
     for i in 0..r.t.len() {
         let t = t0 + i as f64 * dt + jitter(i);
@@ -286,13 +289,7 @@ fn stamps_on_a_given_grid_report_their_largest_deviation_and_refuse_one_too_far(
     assert!(worst > 0.29 * dt, "{worst}");
     assert_eq!(id.record.grid_fitted_over, 0);
 
-    let mut s = Session::new(
-        &model.knowledge(),
-        &Method::algebraic(),
-        Some(model.scenario.speed),
-        timing(),
-    )
-    .unwrap();
+    let mut s = session();
     for i in 0..7 {
         s.push(&sample(i, t0 + i as f64 * dt), &mut |_| {}).unwrap();
     }
