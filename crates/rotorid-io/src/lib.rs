@@ -46,6 +46,7 @@ pub mod mat;
 pub mod npy;
 pub mod npz;
 pub mod num;
+mod par;
 pub mod parquet;
 pub mod select;
 pub mod table;

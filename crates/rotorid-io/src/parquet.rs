@@ -32,6 +32,7 @@ use parquet::column::reader::ColumnReader;
 use parquet::file::reader::{ChunkReader, FileReader, SerializedFileReader};
 
 use crate::error::ReadError;
+use crate::par::PARALLEL_FROM;
 use crate::table::{Channel, Table};
 
 const BATCH: usize = 65_536;
@@ -253,42 +254,8 @@ fn read_inner<R: ChunkReader + 'static>(
         .flat_map(|c| meta.row_groups().iter().map(|g| g.column(c.col)))
         .map(|cc| cc.compressed_size().max(0) as u64)
         .fold(0, u64::saturating_add);
-    let threads = if bytes < parallel_from {
-        1
-    } else {
-        std::thread::available_parallelism()
-            .map_or(1, std::num::NonZeroUsize::get)
-            .min(wanted.len())
-            .min(MAX_THREADS)
-    };
-    let mut results: Vec<Option<ColumnResult>> = Vec::new();
-    if threads <= 1 {
-        results.extend(wanted.iter().map(|c| Some(read(c))));
-    } else {
-        let next = std::sync::atomic::AtomicUsize::new(0);
-        let done: Vec<Vec<(usize, ColumnResult)>> = std::thread::scope(|scope| {
-            let workers: Vec<_> = (0..threads)
-                .map(|_| {
-                    scope.spawn(|| {
-                        let mut out = Vec::new();
-                        loop {
-                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                            let Some(c) = wanted.get(i) else {
-                                return out;
-                            };
-                            out.push((i, read(c)));
-                        }
-                    })
-                })
-                .collect();
-            // (read_column catches the crate's panics; a worker has no other way to panic)
-            workers.into_iter().flat_map(|w| w.join().ok()).collect()
-        });
-        results.resize_with(wanted.len(), || None);
-        for (i, r) in done.into_iter().flatten() {
-            results[i] = Some(r);
-        }
-    }
+    let threads = crate::par::threads_for(wanted.len(), bytes, parallel_from);
+    let results = crate::par::map_ordered(&wanted, threads, read);
     let mut channels = Vec::with_capacity(wanted.len());
     for (c, r) in wanted.into_iter().zip(results) {
         let data = r.unwrap_or_else(|| Err(err(file, Some(&c.name), "its reader failed")))?;
@@ -315,16 +282,6 @@ fn read_inner<R: ChunkReader + 'static>(
         notes: Vec::new(),
     })
 }
-
-/// A column's values, or why it could not be read.
-type ColumnResult = Result<Vec<f64>, ReadError>;
-
-/// At most this many threads decode a file's columns.
-const MAX_THREADS: usize = 4;
-
-/// Columns whose chunks hold fewer bytes than this together are read one by one: starting
-/// threads would cost more than it saves.
-const PARALLEL_FROM: u64 = 1 << 20;
 
 /// A numeric top-level column to read: its index in the schema, name, how its values
 /// become `f64`, and its largest definition level (0 when it cannot hold a null).
