@@ -21,10 +21,11 @@
 //! the column, the row group and the chunk's byte offset, as a null or an inexact integer
 //! does.
 //!
-//! The columns are decoded side by side, on as many threads as the machine offers (at most
-//! four), each column's chunks in order on one thread; a file on disk is read at offsets
-//! (`pread`), which the threads share. Of several bad columns the first in column order is
-//! the one reported, as when they are read one by one.
+//! From 1 MiB of column chunks on, the columns are decoded side by side (`crate::par`: as
+//! many threads as the machine offers, at most four), each column's chunks in order on one
+//! thread; a file on disk is read at offsets (`pread`), which the threads share. Of several
+//! bad columns the first in column order is the one reported, as when they are read one by
+//! one.
 
 use bytes::Bytes;
 use parquet::basic::{ConvertedType, Type as Physical};
