@@ -154,6 +154,27 @@ fn huge_length_fields_never_allocate() {
 }
 
 #[test]
+fn a_forged_hdf5_chunk_address_is_refused_before_anything_is_sized_by_it() {
+    // found by `cargo fuzz run read_mat` (seed 7, 120 s): a 12 KB MAT v7.3 file whose chunk
+    // index puts a chunk at byte 69 900 592 742 912; the HDF5 layer sized a 3 GiB buffer to
+    // span it before finding the file too short
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let path = dir.join("forged_chunk_address_v73.mat");
+    let bytes = std::fs::read(&path).unwrap();
+    assert!(read(Format::Mat, "forged.mat", &bytes));
+    PEAK.with(|p| p.set(0));
+    let e = rotorid_io::read_table(&path).unwrap_err();
+    let peak = PEAK.with(|p| p.get());
+    assert!(peak <= allowed(Format::Mat, "v73", bytes.len()), "{peak}");
+    let text = e.to_string();
+    assert!(
+        text.contains("channel \"x\": HDF5 chunk at element")
+            && text.ends_with(&format!("allowed: within the file's {} bytes", bytes.len())),
+        "{text}"
+    );
+}
+
+#[test]
 fn reading_from_disk_refuses_what_the_bytes_reader_refuses() {
     // `read_table` reads Parquet column chunk by column chunk, NPZ member by member, MAT
     // level 5 element by element, MAT v7.3 in the HDF5 layer's streaming mode, TDMS segment

@@ -181,6 +181,7 @@ fn vector<S: Source + ?Sized>(
     if shape.iter().filter(|&&d| d != 1).count() > 1 || numel == 0 {
         return Ok(Err(format!("a {shown} {class} matrix")));
     }
+    check_storage(file, src.size(), name, ds, size, limit)?;
     let exact = |v: Vec<i128>| -> Result<Vec<f64>, ReadError> {
         v.into_iter()
             .enumerate()
@@ -276,6 +277,70 @@ fn vector<S: Source + ?Sized>(
         });
     }
     Ok(Ok(data))
+}
+
+/// The storage of `ds` (elements of `size` bytes) checked before the HDF5 layer reads it,
+/// which sizes its buffers from it: contiguous data within the file; chunks of at most
+/// `limit` bytes each, each stored within the file (a forged chunk address made the layer
+/// allocate the gigabytes up to it). A chunk index the layer cannot list (B-tree v2) is left
+/// to its own checks.
+fn check_storage(
+    file: &str,
+    len: u64,
+    name: &str,
+    ds: &Dataset,
+    size: u64,
+    limit: u64,
+) -> Result<(), ReadError> {
+    let beyond = |offset: u64, what: String, stored: u64| ReadError::Invalid {
+        file: file.to_string(),
+        channel: Some(name.to_string()),
+        offset,
+        what,
+        found: format!(
+            "{stored} bytes long, ending at byte {}",
+            offset.saturating_add(stored)
+        ),
+        allowed: format!("within the file's {len} bytes"),
+    };
+    match ds.layout() {
+        Ok(Layout::Contiguous {
+            address: Some(a),
+            size: stored,
+        }) if a.checked_add(stored).is_none_or(|end| end > len) => {
+            Err(beyond(a, "HDF5 contiguous dataset storage".into(), stored))
+        }
+        Ok(Layout::Chunked { chunk_shape, .. }) => {
+            let chunk = chunk_shape
+                .iter()
+                .try_fold(size, |a, &d| a.checked_mul(d))
+                .filter(|&b| b <= limit);
+            if chunk.is_none() {
+                return Err(ReadError::Invalid {
+                    file: file.to_string(),
+                    channel: Some(name.to_string()),
+                    offset: data_start(ds),
+                    what: "HDF5 chunk shape (of the dataset whose data starts here)".into(),
+                    found: format!("{chunk_shape:?} elements of {size} bytes"),
+                    allowed: format!("at most {limit} bytes (1032 times the file's size)"),
+                });
+            }
+            for c in ds.chunks().unwrap_or_default() {
+                if c.address
+                    .checked_add(c.storage_size)
+                    .is_none_or(|end| end > len)
+                {
+                    return Err(beyond(
+                        c.address,
+                        format!("HDF5 chunk at element {:?}", c.offset),
+                        c.storage_size,
+                    ));
+                }
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Where the `numel` values of `ds` start in the file when they are IEEE little-endian
