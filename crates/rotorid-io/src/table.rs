@@ -61,12 +61,7 @@ impl Table {
         if let Some(i) = self.channels.iter().position(|c| c.name == name) {
             return Some(i);
         }
-        let mut hits = self
-            .channels
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| last_component(&c.name) == name)
-            .map(|(i, _)| i);
+        let mut hits = self.candidate_indices(name);
         match (hits.next(), hits.next()) {
             (Some(i), None) => Some(i),
             _ => None,
@@ -78,9 +73,19 @@ impl Table {
     where
         'a: 'n,
     {
+        self.candidate_indices(name).map(|i| &self.channels[i])
+    }
+
+    /// The indices of [`Table::candidates`] in [`Table::channels`].
+    fn candidate_indices<'a, 'n>(&'a self, name: &'n str) -> impl Iterator<Item = usize> + 'n
+    where
+        'a: 'n,
+    {
         self.channels
             .iter()
-            .filter(move |c| last_component(&c.name) == name)
+            .enumerate()
+            .filter(move |(_, c)| last_component(&c.name) == name)
+            .map(|(i, _)| i)
     }
 }
 
