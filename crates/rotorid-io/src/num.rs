@@ -8,6 +8,7 @@
 
 use crate::cursor::Cursor;
 use crate::error::ReadError;
+use crate::format::Source;
 
 /// Byte order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -218,4 +219,47 @@ impl Cursor<'_> {
             }
         })
     }
+}
+
+/// `n` values of `t` in byte order `e` of `channel` at byte `at` of `src` (the file `file`),
+/// one every `stride` bytes, read in one piece through `scratch` and appended to `out`; the
+/// values are numbers `first..first + n` of the channel, counted from its first value in the
+/// file (as a [`ReadError::InexactInteger`] names them).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn samples_at<S: Source + ?Sized>(
+    src: &S,
+    file: &str,
+    channel: &str,
+    at: u64,
+    first: u64,
+    n: u64,
+    stride: u64,
+    t: Dtype,
+    e: Endian,
+    scratch: &mut Vec<u8>,
+    out: &mut Vec<f64>,
+) -> Result<(), ReadError> {
+    let len = n.saturating_sub(1) * stride + t.size() as u64;
+    let buf = src.read_at_reusing(at, len, scratch)?;
+    let c = Cursor {
+        base: at,
+        ..Cursor::new(file, buf)
+    };
+    c.samples_into(0, n, stride, t, e, channel, out)
+        .map_err(|err| match err {
+            ReadError::InexactInteger {
+                file,
+                channel,
+                index,
+                offset,
+                value,
+            } => ReadError::InexactInteger {
+                file,
+                channel,
+                index: index + first as usize,
+                offset,
+                value,
+            },
+            other => other,
+        })
 }

@@ -28,10 +28,9 @@
 
 use hdf5_pure::{AttrValue, DType, Dataset, File, Group, Layout};
 
-use crate::cursor::Cursor;
 use crate::error::ReadError;
 use crate::format::Source;
-use crate::num::{Dtype, Endian};
+use crate::num::{samples_at, Dtype, Endian};
 use crate::table::{Channel, Table};
 
 const NUMERIC: &[&str] = &[
@@ -164,24 +163,23 @@ fn vector<S: Source + ?Sized>(
         .map(u64::to_string)
         .collect::<Vec<_>>()
         .join("x");
-    match numel.and_then(|n| n.checked_mul(size)) {
-        Some(b) if b <= limit => {}
-        _ => {
-            return Err(ReadError::Invalid {
-                file: file.to_string(),
-                channel: Some(name.to_string()),
-                offset: data_start(ds),
-                what: "HDF5 dataset extent (of the dataset whose data starts here)".into(),
-                found: format!("{shown} elements of {size} bytes"),
-                allowed: format!("at most {limit} bytes (1032 times the file's size)"),
-            })
-        }
-    }
+    let extent = Bounded {
+        file,
+        name,
+        ds,
+        size,
+        limit,
+    };
+    extent.check(
+        "HDF5 dataset extent",
+        numel.and_then(|n| n.checked_mul(size)),
+        &shown,
+    )?;
     let numel = numel.unwrap_or(0);
     if shape.iter().filter(|&&d| d != 1).count() > 1 || numel == 0 {
         return Ok(Err(format!("a {shown} {class} matrix")));
     }
-    check_storage(file, src.size(), name, ds, size, limit)?;
+    check_storage(&extent, src.size())?;
     let exact = |v: Vec<i128>| -> Result<Vec<f64>, ReadError> {
         v.into_iter()
             .enumerate()
@@ -279,19 +277,41 @@ fn vector<S: Source + ?Sized>(
     Ok(Ok(data))
 }
 
-/// The storage of `ds` (elements of `size` bytes) checked before the HDF5 layer reads it,
-/// which sizes its buffers from it: contiguous data within the file; chunks of at most
-/// `limit` bytes each, each stored within the file (a forged chunk address made the layer
-/// allocate the gigabytes up to it), listed from an index that can be listed. A B-tree v2
-/// index, which the layer cannot list yet, is left to its own checks.
-fn check_storage(
-    file: &str,
-    len: u64,
-    name: &str,
-    ds: &Dataset,
+/// The bound on what a dataset `ds` of channel `name` (elements of `size` bytes) may make
+/// the reader allocate: `limit` bytes (1032 times the file's size).
+struct Bounded<'a> {
+    file: &'a str,
+    name: &'a str,
+    ds: &'a Dataset,
     size: u64,
     limit: u64,
-) -> Result<(), ReadError> {
+}
+
+impl Bounded<'_> {
+    /// `Ok` when `bytes` (of elements shown as `shown`; `None`: beyond 64 bits) are at most
+    /// the limit, else the error naming `what` at the byte where the dataset's data starts.
+    fn check(&self, what: &str, bytes: Option<u64>, shown: &str) -> Result<(), ReadError> {
+        match bytes {
+            Some(b) if b <= self.limit => Ok(()),
+            _ => Err(ReadError::Invalid {
+                file: self.file.to_string(),
+                channel: Some(self.name.to_string()),
+                offset: data_start(self.ds),
+                what: format!("{what} (of the dataset whose data starts here)"),
+                found: format!("{shown} elements of {} bytes", self.size),
+                allowed: format!("at most {} bytes (1032 times the file's size)", self.limit),
+            }),
+        }
+    }
+}
+
+/// The storage of the dataset `b.ds` checked before the HDF5 layer reads it, which sizes
+/// its buffers from it: contiguous data within the file of `len` bytes; chunks within
+/// [`Bounded`]'s limit, each stored within the file (a forged chunk address made the layer
+/// allocate the gigabytes up to it), listed from an index that can be listed. A B-tree v2
+/// index, which the layer cannot list yet, is left to its own checks.
+fn check_storage(b: &Bounded<'_>, len: u64) -> Result<(), ReadError> {
+    let (file, name, ds) = (b.file, b.name, b.ds);
     let beyond = |offset: u64, what: String, stored: u64| ReadError::Invalid {
         file: file.to_string(),
         channel: Some(name.to_string()),
@@ -311,20 +331,10 @@ fn check_storage(
             Err(beyond(a, "HDF5 contiguous dataset storage".into(), stored))
         }
         Ok(Layout::Chunked { chunk_shape, index }) => {
-            let chunk = chunk_shape
+            let bytes = chunk_shape
                 .iter()
-                .try_fold(size, |a, &d| a.checked_mul(d))
-                .filter(|&b| b <= limit);
-            if chunk.is_none() {
-                return Err(ReadError::Invalid {
-                    file: file.to_string(),
-                    channel: Some(name.to_string()),
-                    offset: data_start(ds),
-                    what: "HDF5 chunk shape (of the dataset whose data starts here)".into(),
-                    found: format!("{chunk_shape:?} elements of {size} bytes"),
-                    allowed: format!("at most {limit} bytes (1032 times the file's size)"),
-                });
-            }
+                .try_fold(b.size, |a, &d| a.checked_mul(d));
+            b.check("HDF5 chunk shape", bytes, &format!("{chunk_shape:?}"))?;
             let chunks = match ds.chunks() {
                 Ok(c) => c,
                 // (the layer cannot list a B-tree v2 index yet: left to its own checks)
@@ -386,13 +396,20 @@ fn doubles_at<S: Source + ?Sized>(
     let mut done = 0;
     while done < n {
         let m = PER.min(n - done);
-        let start = at + done * 8;
-        let buf = src.read_at_reusing(start, m * 8, &mut scratch)?;
-        let c = Cursor {
-            base: start,
-            ..Cursor::new(file, buf)
-        };
-        c.samples_into(0, m, 8, Dtype::F64, Endian::Little, name, &mut out)?;
+        let (at, t, e) = (at + done * 8, Dtype::F64, Endian::Little);
+        samples_at(
+            src,
+            file,
+            name,
+            at,
+            done,
+            m,
+            8,
+            t,
+            e,
+            &mut scratch,
+            &mut out,
+        )?;
         done += m;
     }
     Ok(out)

@@ -542,11 +542,8 @@ impl Raw<'_> {
         }
     }
 
-    /// `n` values of `t` of `channel` at file offset `at`, one every `stride` bytes, read
-    /// from `src`; the values are numbers `first..first + n` of the channel, counted from
-    /// its first value in the file over every segment and chunk (as an
-    /// [`ReadError::InexactInteger`] names them). The caller keeps them within the raw data.
-    /// The values go onto the end of `out`; a block read from disk goes through `scratch`.
+    /// [`crate::num::samples_at`] in this file's name and byte order. The caller keeps the
+    /// values within the raw data.
     #[allow(clippy::too_many_arguments)]
     fn samples_into<S: Source + ?Sized>(
         &self,
@@ -560,29 +557,10 @@ impl Raw<'_> {
         scratch: &mut Vec<u8>,
         out: &mut Vec<f64>,
     ) -> Result<(), ReadError> {
-        let len = n.saturating_sub(1) * stride + t.size() as u64;
-        let buf = src.read_at_reusing(at, len, scratch)?;
-        let c = Cursor {
-            base: at,
-            ..Cursor::new(self.file, buf)
-        };
-        c.samples_into(0, n, stride, t, self.e, channel, out)
-            .map_err(|err| match err {
-                ReadError::InexactInteger {
-                    file,
-                    channel,
-                    index,
-                    offset,
-                    value,
-                } => ReadError::InexactInteger {
-                    file,
-                    channel,
-                    index: index + first as usize,
-                    offset,
-                    value,
-                },
-                other => other,
-            })
+        let e = self.e;
+        crate::num::samples_at(
+            src, self.file, channel, at, first, n, stride, t, e, scratch, out,
+        )
     }
 }
 
