@@ -53,28 +53,17 @@ pub fn parse_prefix(s: &[u8]) -> Option<(f64, usize)> {
     let neg = s.first() == Some(&b'-');
     let start = usize::from(neg);
     // integer digits (a leading zero stays in the count: at most 19 digits together)
-    let (mut i, mut w) = digits_from(s, start, 0);
-    let mut digits = i - start;
+    let (mut i, mut w) = one_by_one(s, start, 0);
+    let mut digits_seen = i - start;
     let mut q: i32 = 0;
     if s.get(i) == Some(&b'.') {
         i += 1;
         let f = i;
-        while let Some(v) = load8(s, i) {
-            if !all_digits(v) {
-                break;
-            }
-            w = w.wrapping_mul(100_000_000).wrapping_add(eight(v));
-            i += 8;
-            if i - f > 19 {
-                return None;
-            }
-        }
-        (i, w) = digits_from(s, i, w);
-        digits += i - f;
+        (i, w) = digits(s, i, w, MAX_DIGITS.checked_sub(digits_seen)?)?;
+        digits_seen += i - f;
         q = -((i - f) as i32);
     }
-    // w holds the digits exactly only up to 19 of them (< 10^19 < 2^64)
-    if digits == 0 || digits > 19 {
+    if digits_seen == 0 || digits_seen > MAX_DIGITS {
         return None;
     }
     if matches!(s.get(i), Some(b'e' | b'E')) {
@@ -112,10 +101,42 @@ pub fn parse_prefix(s: &[u8]) -> Option<(f64, usize)> {
     Some((if neg { -v } else { v }, i))
 }
 
+/// Most significant digits taken: `w` holds up to 19 exactly (< 10^19 < 2^64).
+const MAX_DIGITS: usize = 19;
+
+/// The digits of `s` from `i` appended to `w`: where they end, and `w`; `None` past `budget`
+/// digits (the caller declines those). Eight bytes at a time while eight can be loaded (SWAR):
+/// a word of eight digits whole, a shorter run at its start in the same step (so the loop's
+/// exit does not depend on how many digits a field has); one by one near the end of `s`.
+#[inline(always)]
+fn digits(s: &[u8], mut i: usize, mut w: u64, budget: usize) -> Option<(usize, u64)> {
+    let first = i;
+    while let Some(v) = load8(s, i) {
+        let n = leading_digits(v);
+        if n == 8 {
+            w = w.wrapping_mul(100_000_000).wrapping_add(eight(v));
+            i += 8;
+            if i - first > budget {
+                return None;
+            }
+            continue;
+        }
+        if n > 0 {
+            w = w
+                .wrapping_mul(POW10_U64[n])
+                .wrapping_add(eight(right_aligned(v, n)));
+            i += n;
+        }
+        return (i - first <= budget).then_some((i, w));
+    }
+    (i, w) = one_by_one(s, i, w);
+    (i - first <= budget).then_some((i, w))
+}
+
 /// The digits of `s` from `i` appended to `w` one by one: where they end, and `w` (which
 /// wraps past 19 digits in all; the caller refuses those).
 #[inline(always)]
-fn digits_from(s: &[u8], mut i: usize, mut w: u64) -> (usize, u64) {
+fn one_by_one(s: &[u8], mut i: usize, mut w: u64) -> (usize, u64) {
     while let Some(&c) = s.get(i) {
         let d = c.wrapping_sub(b'0');
         if d > 9 {
@@ -127,19 +148,42 @@ fn digits_from(s: &[u8], mut i: usize, mut w: u64) -> (usize, u64) {
     (i, w)
 }
 
+/// How many of the 8 bytes of `v` (first byte first) are ASCII digits before the first
+/// that is not. A byte is flagged when it is below `'0'` (the subtraction borrows) or above
+/// `'9'` (adding 0x46 sets its top bit); the bytes before the first flagged one are digits,
+/// which neither borrow nor carry, so that one is flagged exactly (later bytes may not be).
+#[inline(always)]
+fn leading_digits(v: u64) -> usize {
+    let a = v.wrapping_add(0x4646_4646_4646_4646);
+    let b = v.wrapping_sub(0x3030_3030_3030_3030);
+    ((a | b) & 0x8080_8080_8080_8080).trailing_zeros() as usize / 8
+}
+
+/// The first `n` (1 to 7) bytes of `v`, digits, as the last `n` of an eight-digit word
+/// led by `'0'`s: [`eight`] then reads the `n`-digit number.
+#[inline(always)]
+fn right_aligned(v: u64, n: usize) -> u64 {
+    (v << (8 * (8 - n))) | (0x3030_3030_3030_3030 >> (8 * n))
+}
+
+/// 10^n for n = 0 to 8.
+const POW10_U64: [u64; 9] = [
+    1,
+    10,
+    100,
+    1_000,
+    10_000,
+    100_000,
+    1_000_000,
+    10_000_000,
+    100_000_000,
+];
+
 /// The 8 bytes of `s` from `i`, little endian, when there are 8.
 #[inline(always)]
 fn load8(s: &[u8], i: usize) -> Option<u64> {
     let b: [u8; 8] = s.get(i..i.checked_add(8)?)?.try_into().ok()?;
     Some(u64::from_le_bytes(b))
-}
-
-/// All 8 bytes of `v` are ASCII digits.
-#[inline(always)]
-fn all_digits(v: u64) -> bool {
-    let a = v.wrapping_add(0x4646_4646_4646_4646);
-    let b = v.wrapping_sub(0x3030_3030_3030_3030);
-    (a | b) & 0x8080_8080_8080_8080 == 0
 }
 
 /// The number the 8 digit bytes of `v` spell (its first byte the most significant digit):
@@ -525,7 +569,9 @@ mod tests {
                 prop_oneof![Just(""), Just("-"), Just("+")],
                 0u32..400,
             )),
-            tail in prop_oneof![Just(","), Just("\n"), Just("\r"), Just("x"), Just(""), Just(",1.5")],
+            // (a long tail: the digits are read 8 bytes at a time up to the number's end)
+            tail in prop_oneof![Just(","), Just("\n"), Just("\r"), Just("x"), Just(""), Just(",1.5"),
+                Just(",125.66370614359172,5.889325051644407e-11\n")],
         ) {
             let mut s = String::new();
             if neg {
