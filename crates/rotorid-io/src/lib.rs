@@ -19,6 +19,12 @@
 //! layer's streaming mode, TDMS segments, UFF58 lines), so memory holds the channels and
 //! one piece (about 1.3x the channels at most); both accept and refuse alike.
 //!
+//! Where the format allows it, a record can also be read a block of rows at a time
+//! ([`open_blocks`]: Parquet now), with the channels for t, x, z, ... picked and converted
+//! to SI a block at a time ([`SiBlocks`]) exactly as [`select()`] picks and converts them:
+//! `rotorid identify` reads such a file on one thread while it identifies on another, in
+//! memory that does not grow with the record ([`stream`]).
+//!
 //! [`write_table`] writes a table back as NPZ, MAT level 5 or Parquet ([`mod@write`]).
 //!
 //! Samples are passed through as stored: NaN and infinities are data here, and the
@@ -49,6 +55,7 @@ pub mod num;
 mod par;
 pub mod parquet;
 pub mod select;
+pub mod stream;
 pub mod table;
 pub mod tdms;
 pub mod uff;
@@ -58,6 +65,7 @@ pub mod write;
 pub use error::ReadError;
 pub use format::{read_bytes, read_table, Format};
 pub use select::{select, ColumnMap, SelectError, SiColumns};
-pub use table::{Channel, Table, TimeAxis};
+pub use stream::{open_blocks, RowBlocks, SiBlock, SiBlocks};
+pub use table::{Channel, ChannelInfo, Table, TimeAxis};
 pub use units::{Conversion, Quantity, UnitError};
 pub use write::{write_table, WriteError};

@@ -26,6 +26,11 @@
 //! thread; a file on disk is read at offsets (`pread`), which the threads share. Of several
 //! bad columns the first in column order is the one reported, as when they are read one by
 //! one.
+//!
+//! [`open_blocks`] reads the same file a block of rows at a time ([`crate::stream`]): the
+//! same checks before decoding, then one column reader per column asked for, each advanced
+//! by the rows asked for, row group after row group; memory holds a page per column and
+//! the block. A column chunk must decode to the value count its metadata declares.
 
 use bytes::Bytes;
 use parquet::basic::{ConvertedType, Type as Physical};
@@ -34,7 +39,7 @@ use parquet::file::reader::{ChunkReader, FileReader, SerializedFileReader};
 
 use crate::error::ReadError;
 use crate::par::PARALLEL_FROM;
-use crate::table::{Channel, Table};
+use crate::table::{Channel, ChannelInfo, Table};
 
 const BATCH: usize = 65_536;
 
@@ -73,6 +78,233 @@ fn read_file_with(
     guarded(file, || {
         read_inner(file, handle, disk.size, &chunk, parallel_from)
     })
+}
+
+/// Opens the Parquet file at `path` to be read a block of rows at a time
+/// ([`crate::stream`]): every check of [`read_file`] that comes before decoding runs here
+/// (footer, row count, page headers); then each column is decoded as its rows are asked
+/// for, one `parquet` crate column reader per column read, so memory holds a page per
+/// column and the rows asked for, never the whole column.
+///
+/// A column's length is the sum of its column chunks' value counts (`num_values`); a chunk
+/// that decodes to another count is an error naming the column, the row group and the
+/// chunk's offset (the whole-file reader takes what the chunk decodes to; a file that
+/// differs between the two has a footer that contradicts its pages).
+pub fn open_blocks(file: &str, path: &std::path::Path) -> Result<ParquetBlocks, ReadError> {
+    let disk = crate::format::DiskFile::open(file, path)?;
+    let handle = Positional {
+        f: std::sync::Arc::new(disk.handle()?),
+        size: disk.size,
+    };
+    let chunk = |start: u64, len: u64| disk.read_at(start, len);
+    let opened = crate::guard::quietly(|| open(file, handle, disk.size, &chunk))
+        .unwrap_or_else(|| Err(malformed(file)))?;
+    let meta = opened.reader.metadata();
+    let mut channels = Vec::with_capacity(opened.wanted.len());
+    for c in &opened.wanted {
+        let len = meta
+            .row_groups()
+            .iter()
+            .map(|g| g.column(c.col).num_values().max(0) as u64)
+            .fold(0, u64::saturating_add);
+        if len > opened.limit {
+            return Err(err(
+                file,
+                Some(&c.name),
+                format!(
+                    "its column chunks declare {len} values, more than {} (1032 times the \
+                     file's size)",
+                    opened.limit
+                ),
+            ));
+        }
+        channels.push(ChannelInfo {
+            name: c.name.clone(),
+            unit: None,
+            len: len as usize,
+            axis: None,
+        });
+    }
+    let cursors = opened.wanted.iter().map(|_| None).collect();
+    Ok(ParquetBlocks {
+        file: file.to_string(),
+        opened,
+        channels,
+        cursors,
+    })
+}
+
+/// A Parquet file read a block of rows at a time ([`open_blocks`]).
+pub struct ParquetBlocks {
+    file: String,
+    opened: Opened<Positional>,
+    channels: Vec<ChannelInfo>,
+    /// Per column: where its reading stands, once asked for.
+    cursors: Vec<Option<ColumnCursor>>,
+}
+
+/// Where one column's reading stands: its row group, that chunk's reader and batch state,
+/// and the values given so far.
+struct ColumnCursor {
+    row_group: usize,
+    reader: Option<ColumnReader>,
+    batch: Batch,
+    /// Values read from the current chunk.
+    in_chunk: u64,
+    /// Values given so far.
+    given: usize,
+}
+
+impl crate::stream::RowBlocks for ParquetBlocks {
+    fn file(&self) -> &str {
+        &self.file
+    }
+
+    fn channels(&self) -> &[ChannelInfo] {
+        &self.channels
+    }
+
+    fn notes(&self) -> &[String] {
+        &[]
+    }
+
+    fn next_rows(
+        &mut self,
+        wanted: &[usize],
+        max_rows: usize,
+        out: &mut [Vec<f64>],
+    ) -> Result<usize, ReadError> {
+        let Some(&first) = wanted.first() else {
+            return Ok(0);
+        };
+        let given = self.cursors[first].as_ref().map_or(0, |c| c.given);
+        let n = max_rows.min(self.channels[first].len.saturating_sub(given));
+        for (&k, data) in wanted.iter().zip(out.iter_mut()) {
+            let file = self.file.as_str();
+            let opened = &self.opened;
+            let cursor = self.cursors[k].get_or_insert_with(|| ColumnCursor {
+                row_group: 0,
+                reader: None,
+                batch: Batch {
+                    defs: Vec::new(),
+                    row0: 0,
+                    index0: 0,
+                    data_start: 0,
+                },
+                in_chunk: 0,
+                given: 0,
+            });
+            // A panic of the crate in this column names it (crate::guard).
+            crate::guard::quietly(|| fill(file, opened, &opened.wanted[k], cursor, n, data))
+                .unwrap_or_else(|| {
+                    Err(cursor_undecodable(file, opened, &opened.wanted[k], cursor))
+                })?;
+        }
+        Ok(n)
+    }
+}
+
+/// `n` more values of column `c` appended to `data`, through its `cursor`, row group after
+/// row group; each finished chunk must have given its declared value count.
+fn fill(
+    file: &str,
+    opened: &Opened<Positional>,
+    c: &Column,
+    cursor: &mut ColumnCursor,
+    n: usize,
+    data: &mut Vec<f64>,
+) -> Result<(), ReadError> {
+    let meta = opened.reader.metadata();
+    let target = data.len() + n;
+    cursor.batch.index0 = cursor.given;
+    cursor.batch.data_start = data.len();
+    while data.len() < target {
+        if cursor.row_group >= meta.num_row_groups() {
+            return Err(err(
+                file,
+                Some(&c.name),
+                format!(
+                    "the column ends after {} values, its column chunks declare more",
+                    cursor.given + (data.len() - cursor.batch.data_start)
+                ),
+            ));
+        }
+        let at = chunk_at(opened, c, cursor.row_group);
+        let reader = match &mut cursor.reader {
+            Some(r) => r,
+            None => cursor
+                .reader
+                .insert(column_reader(file, &opened.reader, c.col, &at)?),
+        };
+        let before = data.len();
+        let got = cursor.batch.read(
+            file,
+            reader,
+            c.kind,
+            c.max_def,
+            &at,
+            target - data.len(),
+            data,
+        )?;
+        cursor.in_chunk += (data.len() - before) as u64;
+        if got == 0 {
+            let declared = meta
+                .row_group(cursor.row_group)
+                .column(c.col)
+                .num_values()
+                .max(0) as u64;
+            if cursor.in_chunk != declared {
+                return Err(ReadError::Invalid {
+                    file: file.to_string(),
+                    channel: Some(c.name.clone()),
+                    offset: at.offset,
+                    what: format!("the Parquet column chunk of row group {}", at.row_group),
+                    found: format!("{} values", cursor.in_chunk),
+                    allowed: format!("the {declared} values its metadata declares"),
+                });
+            }
+            cursor.row_group += 1;
+            cursor.reader = None;
+            cursor.in_chunk = 0;
+            cursor.batch.row0 = 0;
+        }
+    }
+    cursor.given += n;
+    Ok(())
+}
+
+/// Column `c`'s chunk in row group `rg`, as messages name it.
+fn chunk_at<'a>(opened: &Opened<Positional>, c: &'a Column, rg: usize) -> Chunk<'a> {
+    let cc = opened.reader.metadata().row_group(rg).column(c.col);
+    Chunk {
+        name: &c.name,
+        row_group: rg,
+        offset: cc.dictionary_page_offset().unwrap_or(cc.data_page_offset()) as u64,
+        len: cc.compressed_size() as u64,
+    }
+}
+
+/// The error for the chunk a column's cursor was in when the `parquet` crate panicked.
+fn cursor_undecodable(
+    file: &str,
+    opened: &Opened<Positional>,
+    c: &Column,
+    cursor: &ColumnCursor,
+) -> ReadError {
+    let rg = cursor
+        .row_group
+        .min(opened.reader.metadata().num_row_groups().saturating_sub(1));
+    chunk_at(opened, c, rg).undecodable(file)
+}
+
+/// The error for a file on which the `parquet` crate panicked before any column.
+fn malformed(file: &str) -> ReadError {
+    ReadError::Container {
+        file: file.to_string(),
+        channel: None,
+        container: "Parquet",
+        message: "the parquet reader failed on a malformed structure".into(),
+    }
 }
 
 /// The file read at offsets (`pread`), so that threads decoding column chunks side by side
@@ -130,14 +362,7 @@ impl std::io::Read for At {
 /// `run`, with a panic of the third-party parser on a hostile file made an error.
 fn guarded(file: &str, run: impl FnOnce() -> Result<Table, ReadError>) -> Result<Table, ReadError> {
     // A third-party parser: a panic on a hostile file becomes an error here (crate::guard).
-    crate::guard::quietly(run).unwrap_or_else(|| {
-        Err(ReadError::Container {
-            file: file.to_string(),
-            channel: None,
-            container: "Parquet",
-            message: "the parquet reader failed on a malformed structure".into(),
-        })
-    })
+    crate::guard::quietly(run).unwrap_or_else(|| Err(malformed(file)))
 }
 
 fn err(file: &str, channel: Option<&str>, e: impl ToString) -> ReadError {
@@ -160,16 +385,27 @@ enum Kind {
 /// The bytes `[start, start + len)` of the file (within its size: checked by the caller).
 type ChunkFn<'a> = dyn Fn(u64, u64) -> Result<Vec<u8>, ReadError> + 'a;
 
-/// The table of a Parquet file of `size` bytes, read through `source`; `chunk` gives a
-/// column chunk's bytes for [`check_pages`]. The columns are decoded side by side when
-/// their chunks hold `parallel_from` bytes or more together.
-fn read_inner<R: ChunkReader + 'static>(
+/// A Parquet file's reader and its catalogue, checked ([`open`]).
+struct Opened<R: ChunkReader + 'static> {
+    reader: SerializedFileReader<R>,
+    /// The numeric top-level columns, in schema order.
+    wanted: Vec<Column>,
+    /// The declared rows of every row group together (checked against the file's size).
+    rows: u64,
+    /// The most values a column may hold: 1032 times the file's size.
+    limit: u64,
+}
+
+/// The reader of a Parquet file of `size` bytes, read through `source`, and its numeric
+/// columns, after every check that comes before decoding: the footer ([`check_footer`]),
+/// its row count, every page header of every column chunk ([`check_pages`]; `chunk` gives
+/// a column chunk's bytes); no numeric column is an error listing what was skipped.
+fn open<R: ChunkReader + 'static>(
     file: &str,
     source: R,
     size: u64,
     chunk: &ChunkFn<'_>,
-    parallel_from: u64,
-) -> Result<Table, ReadError> {
+) -> Result<Opened<R>, ReadError> {
     let footer = check_footer(file, size, chunk)?;
     let reader = SerializedFileReader::new(source).map_err(|e| err(file, None, e))?;
     let meta = reader.metadata();
@@ -244,9 +480,44 @@ fn read_inner<R: ChunkReader + 'static>(
             )),
         }
     }
+    if wanted.is_empty() {
+        return Err(ReadError::NoChannels {
+            file: file.to_string(),
+            why: if skipped.is_empty() {
+                "no columns".into()
+            } else {
+                format!("skipped: {}", skipped.join(", "))
+            },
+        });
+    }
+    Ok(Opened {
+        reader,
+        wanted,
+        rows: rows as u64,
+        limit,
+    })
+}
+
+/// The table of a Parquet file of `size` bytes, read through `source` (checked by
+/// [`open`]; `chunk` gives a column chunk's bytes). The columns are decoded side by side
+/// when their chunks hold `parallel_from` bytes or more together.
+fn read_inner<R: ChunkReader + 'static>(
+    file: &str,
+    source: R,
+    size: u64,
+    chunk: &ChunkFn<'_>,
+    parallel_from: u64,
+) -> Result<Table, ReadError> {
+    let Opened {
+        reader,
+        wanted,
+        rows,
+        limit,
+    } = open(file, source, size, chunk)?;
+    let meta = reader.metadata();
     // The declared rows, but never more values than the file has bytes: a hostile footer
     // cannot make a column's allocation larger than 8 bytes per byte of the file.
-    let capacity = (rows as u64).min(size) as usize;
+    let capacity = rows.min(size) as usize;
     let read = |c: &Column| read_column(file, &reader, c, capacity, limit);
     // Columns side by side, each thread taking the next column not yet taken; the first
     // error in column order is the one reported, as when they are read one by one.
@@ -265,16 +536,6 @@ fn read_inner<R: ChunkReader + 'static>(
             unit: None,
             data,
             axis: None,
-        });
-    }
-    if channels.is_empty() {
-        return Err(ReadError::NoChannels {
-            file: file.to_string(),
-            why: if skipped.is_empty() {
-                "no columns".into()
-            } else {
-                format!("skipped: {}", skipped.join(", "))
-            },
         });
     }
     Ok(Table {
@@ -362,30 +623,85 @@ fn read_chunk<R: ChunkReader + 'static>(
     at: &Chunk<'_>,
     data: &mut Vec<f64>,
 ) -> Result<(), ReadError> {
-    let (name, rg) = (at.name, at.row_group);
-    let group = reader
-        .get_row_group(rg)
-        .map_err(|e| err(file, Some(name), e))?;
-    let mut col_reader = group
-        .get_column_reader(col)
-        .map_err(|e| err(file, Some(name), e))?;
-    let mut defs: Vec<i16> = Vec::new();
-    let mut row0 = 0usize;
+    let mut col_reader = column_reader(file, reader, col, at)?;
+    let mut batch = Batch {
+        defs: Vec::new(),
+        row0: 0,
+        index0: 0,
+        data_start: 0,
+    };
     loop {
+        let n = batch.read(file, &mut col_reader, kind, max_def, at, BATCH, data)?;
+        if n == 0 {
+            return Ok(());
+        }
+        if data.len() as u64 > limit {
+            return Err(err(
+                file,
+                Some(at.name),
+                format!("more than {limit} values"),
+            ));
+        }
+    }
+}
+
+/// The reader of column `col` in the row group of `at`.
+fn column_reader<R: ChunkReader + 'static>(
+    file: &str,
+    reader: &SerializedFileReader<R>,
+    col: usize,
+    at: &Chunk<'_>,
+) -> Result<ColumnReader, ReadError> {
+    reader
+        .get_row_group(at.row_group)
+        .and_then(|g| g.get_column_reader(col))
+        .map_err(|e| err(file, Some(at.name), e))
+}
+
+/// Where a column chunk's reading stands, for [`Batch::read`] and its messages.
+struct Batch {
+    /// Definition levels of the last batch (scratch).
+    defs: Vec<i16>,
+    /// Rows of the row group read before the next batch.
+    row0: usize,
+    /// The channel's index of the value at `data[data_start]` (for messages).
+    index0: usize,
+    /// Where in `data` the values counted from `index0` start.
+    data_start: usize,
+}
+
+impl Batch {
+    /// At most `max` more values of the column chunk `at` through `col_reader`, appended
+    /// to `data` as `f64` by `kind`; 0 at the chunk's end. A null (a definition level below
+    /// `max_def`) or an `INT64` that no `f64` holds exactly is an error naming its row and
+    /// index.
+    #[allow(clippy::too_many_arguments)]
+    fn read(
+        &mut self,
+        file: &str,
+        col_reader: &mut ColumnReader,
+        kind: Kind,
+        max_def: i16,
+        at: &Chunk<'_>,
+        max: usize,
+        data: &mut Vec<f64>,
+    ) -> Result<usize, ReadError> {
+        let (name, rg) = (at.name, at.row_group);
+        let defs = &mut self.defs;
         defs.clear();
-        let def = (max_def > 0).then_some(&mut defs);
-        let n = match &mut col_reader {
+        let def = (max_def > 0).then_some(&mut *defs);
+        let n = match col_reader {
             ColumnReader::DoubleColumnReader(r) => {
                 // (the values are appended to `data`, decoded in place)
                 let (recs, _, _) = r
-                    .read_records(BATCH, def, None, data)
+                    .read_records(max, def, None, data)
                     .map_err(|e| err(file, Some(name), e))?;
                 recs
             }
             ColumnReader::FloatColumnReader(r) => {
                 let mut v = Vec::new();
                 let (recs, _, _) = r
-                    .read_records(BATCH, def, None, &mut v)
+                    .read_records(max, def, None, &mut v)
                     .map_err(|e| err(file, Some(name), e))?;
                 data.extend(v.into_iter().map(f64::from));
                 recs
@@ -393,7 +709,7 @@ fn read_chunk<R: ChunkReader + 'static>(
             ColumnReader::Int32ColumnReader(r) => {
                 let mut v = Vec::new();
                 let (recs, _, _) = r
-                    .read_records(BATCH, def, None, &mut v)
+                    .read_records(max, def, None, &mut v)
                     .map_err(|e| err(file, Some(name), e))?;
                 match kind {
                     Kind::Unsigned => data.extend(v.into_iter().map(|x| f64::from(x as u32))),
@@ -404,7 +720,7 @@ fn read_chunk<R: ChunkReader + 'static>(
             ColumnReader::Int64ColumnReader(r) => {
                 let mut v = Vec::new();
                 let (recs, _, _) = r
-                    .read_records(BATCH, def, None, &mut v)
+                    .read_records(max, def, None, &mut v)
                     .map_err(|e| err(file, Some(name), e))?;
                 for x in v {
                     let wide = match kind {
@@ -416,7 +732,7 @@ fn read_chunk<R: ChunkReader + 'static>(
                         return Err(ReadError::InexactInteger {
                             file: file.to_string(),
                             channel: name.to_string(),
-                            index: data.len(),
+                            index: self.index0 + (data.len() - self.data_start),
                             offset: at.offset,
                             value: wide,
                         });
@@ -434,19 +750,14 @@ fn read_chunk<R: ChunkReader + 'static>(
                 offset: at.offset,
                 what: format!(
                     "row {} of row group {rg}, in the Parquet column chunk",
-                    row0 + i
+                    self.row0 + i
                 ),
                 found: "a null".into(),
                 allowed: "a value in every row".into(),
             });
         }
-        if n == 0 {
-            return Ok(());
-        }
-        row0 += n;
-        if data.len() as u64 > limit {
-            return Err(err(file, Some(name), format!("more than {limit} values")));
-        }
+        self.row0 += n;
+        Ok(n)
     }
 }
 

@@ -50,6 +50,13 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         tables::print_report(&c);
         let cols = tables::conditioned_columns(c);
         (args.input.clone(), stream::Source::Columns(cols))
+    } else if let Some(blocks) = tables::is_tabular(&args.input, columns)
+        .then(|| tables::blocks(&args.input, columns))
+        .transpose()?
+        .flatten()
+    {
+        // a TDMS or Parquet file: read a block of rows at a time as it is identified
+        (args.input.clone(), stream::Source::Blocks(blocks))
     } else if tables::is_tabular(&args.input, columns) {
         let table = tables::read(&args.input)?;
         let cols = tables::columns(table, columns)?;

@@ -12,7 +12,7 @@ use rotorid::acquisition::{
 use rotorid::pipeline::{identify, Knowledge, Method, Record};
 use rotorid::scenario_file::ScenarioSpec;
 use rotorid_io::units::{conversion, Quantity};
-use rotorid_io::{select, ColumnMap, Format, SiColumns, Table};
+use rotorid_io::{select, ColumnMap, Format, SiBlocks, SiColumns, Table};
 
 /// True when `input` is read whole as a table rather than streamed as a response CSV: a
 /// regular file whose extension is not a CSV one, or any file with `--columns`.
@@ -42,13 +42,41 @@ pub fn read(path: &str) -> anyhow::Result<Table> {
 /// SI; `columns` is the `--columns` text. Each converted channel is noted on stderr. The
 /// table is consumed: its channels become the columns without a copy.
 pub fn columns(table: Table, columns: Option<&str>) -> anyhow::Result<SiColumns> {
-    let map = match columns {
+    let file = table.file.clone();
+    let cols = select(table, &column_map(columns)?)?;
+    print_selection(&file, &cols.used, cols.time_from_axis);
+    Ok(cols)
+}
+
+/// The file at `path` read a block of rows at a time, when its format streams (TDMS,
+/// Parquet: `rotorid_io::stream`), with the channels that play each role (`columns` as in
+/// [`columns`]) checked before any sample is read; the reader's notes and each converted
+/// channel are noted on stderr as [`read`] and [`columns`] note them. `None` for a format
+/// that is read whole.
+pub fn blocks(path: &str, columns: Option<&str>) -> anyhow::Result<Option<SiBlocks>> {
+    let Some(reader) = rotorid_io::open_blocks(path)? else {
+        return Ok(None);
+    };
+    for n in reader.notes() {
+        eprintln!("note: {}: {n}", reader.file());
+    }
+    let blocks = SiBlocks::new(reader, &column_map(columns)?)?;
+    print_selection(blocks.file(), blocks.used(), blocks.time_from_axis());
+    Ok(Some(blocks))
+}
+
+/// The `--columns` text as a map (the default names without it).
+fn column_map(columns: Option<&str>) -> anyhow::Result<ColumnMap> {
+    Ok(match columns {
         Some(spec) => ColumnMap::parse(spec)?,
         None => ColumnMap::default(),
-    };
-    let file = table.file.clone();
-    let cols = select(table, &map)?;
-    for u in cols.used.iter().filter(|u| !u.conversion.is_identity()) {
+    })
+}
+
+/// The notes on stderr of the channels `used` of `file` that were converted to SI, and of
+/// a time taken from the file's time axis.
+fn print_selection(file: &str, used: &[rotorid_io::select::Used], time_from_axis: bool) {
+    for u in used.iter().filter(|u| !u.conversion.is_identity()) {
         eprintln!(
             "note: {}: {} ({}) in {}, converted to {} (x {:e})",
             file,
@@ -59,13 +87,12 @@ pub fn columns(table: Table, columns: Option<&str>) -> anyhow::Result<SiColumns>
             u.conversion.factor()
         );
     }
-    if cols.time_from_axis {
+    if time_from_axis {
         eprintln!(
             "note: {}: time from the file's time axis (no time channel)",
             file
         );
     }
-    Ok(cols)
 }
 
 /// The raw record of `table` for `acq`: every channel by name, the ones `acq` uses in SI

@@ -453,6 +453,74 @@ fn circles(svg: &str) -> Vec<(f64, f64)> {
 }
 
 #[test]
+fn a_parquet_record_is_identified_as_it_is_read() {
+    // A Parquet file is read a block of rows at a time while the rows before are
+    // identified (rotorid_io::stream): a null at row 40000 of x stops the run there, after
+    // the estimates of the rows before it were written (read whole, the file would give
+    // none), and the error names the column and the row.
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_owned();
+    run(&[
+        "simulate",
+        "--scenario",
+        "table1",
+        "--duration",
+        "5",
+        "--out",
+        &p("r.csv"),
+        "-q",
+    ]);
+    let table = rotorid_io::read_table(p("r.csv")).unwrap();
+    let null_at = 40_000;
+    let x: Vec<Option<f64>> = table
+        .channel("x")
+        .unwrap()
+        .data
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| (i != null_at).then_some(v))
+        .collect();
+    let cols: Vec<(&str, rotorid_io::write::ParquetColumn<'_>)> = table
+        .channels
+        .iter()
+        .map(|c| {
+            let col = if c.name == "x" {
+                rotorid_io::write::ParquetColumn::Optional(&x)
+            } else {
+                rotorid_io::write::ParquetColumn::Required(&c.data)
+            };
+            (c.name.as_str(), col)
+        })
+        .collect();
+    let bytes = rotorid_io::write::parquet_columns_bytes("r.parquet", &cols).unwrap();
+    std::fs::write(p("r.parquet"), bytes).unwrap();
+    let out = rotorid()
+        .args([
+            "identify",
+            &p("r.parquet"),
+            "--scenario",
+            "table1",
+            "--out",
+            &p("e.csv"),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("r.parquet, channel \"x\"") && stderr.contains("row 40000 of row group 0"),
+        "{stderr}"
+    );
+    let written = std::fs::read_to_string(p("e.csv")).unwrap();
+    // (a header, then a row per sample from the grid's head on)
+    let rows = written.lines().count().saturating_sub(1);
+    assert!(
+        rows > 10_000 && rows < null_at,
+        "{rows} estimate rows written before the null"
+    );
+}
+
+#[test]
 fn a_panic_of_the_parquet_crate_is_an_error_without_a_panic_message() {
     // Found by fuzzing read_parquet: a BYTE_STREAM_SPLIT page shorter than its value count,
     // on which the parquet crate (59.3.2) indexes out of bounds. rotorid reports an error

@@ -32,6 +32,10 @@ use crate::io::{
 /// Rows a reader thread parses before it hands them over.
 const BATCH_ROWS: usize = 4096;
 
+/// Rows of a block read from a file that streams (TDMS, Parquet): 2^14 rows of six
+/// channels are 768 KiB.
+const BLOCK_ROWS: usize = 1 << 14;
+
 /// Batches the reader thread may run ahead of the identification.
 const BATCHES_AHEAD: usize = 4;
 
@@ -153,6 +157,8 @@ pub(crate) enum Source {
     /// t \[s\], x, z \[m\] and optional phi \[rad\], phi_dot \[rad/s\], phi_ddot
     /// \[rad/s^2\].
     Columns(rotorid_io::SiColumns),
+    /// The same, read a block of rows at a time from a file whose format streams.
+    Blocks(rotorid_io::SiBlocks),
 }
 
 /// Read `input`, identify it by `method` with what `spec` knows, write the estimates CSV
@@ -202,6 +208,7 @@ pub(crate) fn identify(
             read_all(io, hooked, &state, profile)
         }
         Source::Columns(cols) => push_columns(io, &cols, &state, profile),
+        Source::Blocks(blocks) => push_blocks_threaded(io, blocks, &state, profile),
     };
     let State { session, mut rows } = Rc::try_unwrap(state)
         .map_err(|_| anyhow::anyhow!("the input still holds the session"))?
@@ -378,7 +385,13 @@ fn push_columns(
     state: &Rc<RefCell<State>>,
     profile: Option<SpeedProfile>,
 ) -> anyhow::Result<()> {
-    if cols.speed.is_none() && profile.is_none() {
+    need_speed(io, cols.speed.is_some(), profile)?;
+    push_rows(io, 0, &cols.t, &cols.x, &cols.z, cols.speed.as_ref(), state)
+}
+
+/// An error when neither the file nor the scenario gives the speed.
+fn need_speed(io: &Io, has_speed: bool, profile: Option<SpeedProfile>) -> anyhow::Result<()> {
+    if !has_speed && profile.is_none() {
         anyhow::bail!(
             "{}: has no phi, phi_dot, phi_ddot channels and the scenario has no [speed] \
              section: give the rotor angle in the data (--columns t,x,z,phi,phi_dot,phi_ddot) \
@@ -386,22 +399,73 @@ fn push_columns(
             io.name
         );
     }
-    for i in 0..cols.x.len() {
+    Ok(())
+}
+
+/// The rows of columns t, x, z and speed, the record's samples `first..`, into the session
+/// (sample i named as such in messages).
+fn push_rows(
+    io: &Io,
+    first: usize,
+    t: &[f64],
+    x: &[f64],
+    z: &[f64],
+    speed: Option<&[Vec<f64>; 3]>,
+    state: &Rc<RefCell<State>>,
+) -> anyhow::Result<()> {
+    for j in 0..x.len() {
         let s = Sample {
-            t: Some(cols.t[i]),
-            x: cols.x[i],
-            z: cols.z[i],
-            speed: cols.speed.as_ref().map(|[p, w, a]| rotorid::SpeedState {
-                phi: p[i],
-                omega: w[i],
-                omega_dot: a[i],
+            t: Some(t[j]),
+            x: x[j],
+            z: z[j],
+            speed: speed.map(|[p, w, a]| rotorid::SpeedState {
+                phi: p[j],
+                omega: w[j],
+                omega_dot: a[j],
             }),
         };
         push(io, state, &s, |m| {
-            anyhow::anyhow!("{}, sample {i} (t = {} s): {m}", io.name, cols.t[i])
+            let i = first + j;
+            anyhow::anyhow!("{}, sample {i} (t = {} s): {m}", io.name, t[j])
         })?;
     }
     Ok(())
+}
+
+/// Every sample of `blocks` into the session, read a block at a time on a second thread
+/// while this one identifies the block before (at most [`BATCHES_AHEAD`] blocks ahead, so
+/// memory holds a few blocks whatever the record's length); a read error arrives after
+/// every sample before it, as on one thread.
+fn push_blocks_threaded(
+    io: &Io,
+    mut blocks: rotorid_io::SiBlocks,
+    state: &Rc<RefCell<State>>,
+    profile: Option<SpeedProfile>,
+) -> anyhow::Result<()> {
+    need_speed(io, blocks.has_speed(), profile)?;
+    type Block = Result<rotorid_io::SiBlock, rotorid_io::ReadError>;
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Block>(BATCHES_AHEAD);
+    std::thread::scope(|scope| {
+        scope.spawn(move || loop {
+            let next = blocks.next_block(BLOCK_ROWS).transpose();
+            let stop = !matches!(next, Some(Ok(_)));
+            // a send fails only when the identification stopped: nothing more to do
+            if let Some(b) = next {
+                if tx.send(b).is_err() {
+                    return;
+                }
+            }
+            if stop {
+                return;
+            }
+        });
+        // rx is dropped on the first error, which stops the reader at its next send
+        for b in rx {
+            let b = b?;
+            push_rows(io, b.first, &b.t, &b.x, &b.z, b.speed.as_ref(), state)?;
+        }
+        Ok(())
+    })
 }
 
 /// The message of an error at the end of the input, in the command's terms (its options
