@@ -13,7 +13,7 @@
 //! channel, the time axis a format implies (TDMS `wf_increment`, a UFF58 abscissa) gives
 //! t_i = start + i * increment. Channels in SI are passed through bit for bit.
 
-use crate::table::{Table, TimeAxis};
+use crate::table::{index_named, indices_short_named, Described, Table, TimeAxis};
 use crate::units::{conversion, Conversion, Quantity, UnitError};
 
 /// The roles, in the order `--columns` lists them.
@@ -197,7 +197,7 @@ pub struct Used {
 /// place, so the result holds the samples once (a channel that plays two roles is copied
 /// for the first). Every check runs before anything is moved.
 pub fn select(mut table: Table, map: &ColumnMap) -> Result<SiColumns, SelectError> {
-    let plan = plan(&table, map)?;
+    let plan = plan(&table.file, &table.channels, map)?;
     let mut uses = vec![0_usize; table.channels.len()];
     for &(_, i, _) in &plan.order {
         uses[i] += 1;
@@ -237,21 +237,27 @@ pub fn select(mut table: Table, map: &ColumnMap) -> Result<SiColumns, SelectErro
 /// What [`select`] takes from a table, checked: (role, channel index, conversion to SI) in
 /// the order the channels are used (x, z, t, phi, phi_dot, phi_ddot), the time axis and
 /// length when t comes from it, and whether the speed channels are there.
-struct Plan {
-    order: Vec<(usize, usize, Conversion)>,
-    axis: Option<(TimeAxis, usize)>,
-    speed: bool,
+pub(crate) struct Plan {
+    pub(crate) order: Vec<(usize, usize, Conversion)>,
+    pub(crate) axis: Option<(TimeAxis, usize)>,
+    pub(crate) speed: bool,
 }
 
-/// Every check of [`select`], before anything is moved.
-fn plan(table: &Table, map: &ColumnMap) -> Result<Plan, SelectError> {
-    let file = table.file.as_str();
+/// Every check of [`select`], before anything is moved, on the `channels` of `file` (held
+/// or still in the file: [`crate::stream`] plans by the catalogue).
+pub(crate) fn plan<C: Described>(
+    file: &str,
+    channels: &[C],
+    map: &ColumnMap,
+) -> Result<Plan, SelectError> {
     let find = |role: usize| -> Result<Option<usize>, SelectError> {
         let name = map.names[role].as_str();
-        if let Some(i) = table.channel_index(name) {
+        if let Some(i) = index_named(channels, C::name, name) {
             return Ok(Some(i));
         }
-        let candidates: Vec<&str> = table.candidates(name).map(|c| c.name.as_str()).collect();
+        let candidates: Vec<&str> = indices_short_named(channels, C::name, name)
+            .map(|i| channels[i].name())
+            .collect();
         if candidates.len() > 1 {
             return Err(SelectError::Ambiguous {
                 file: file.to_owned(),
@@ -266,29 +272,29 @@ fn plan(table: &Table, map: &ColumnMap) -> Result<Plan, SelectError> {
         file: file.to_owned(),
         role: ROLES[role],
         name: map.names[role].clone(),
-        available: available(table),
+        available: available(channels),
     };
     let x = find(1)?.ok_or_else(|| missing(1))?;
     let z = find(2)?.ok_or_else(|| missing(2))?;
-    let reference = &table.channels[x];
-    let n = reference.data.len();
+    let reference = &channels[x];
+    let n = reference.len();
     let mut order = Vec::with_capacity(6);
     let mut check = |role: usize, i: usize| -> Result<(), SelectError> {
-        let c = &table.channels[i];
-        if c.data.len() != n {
+        let c = &channels[i];
+        if c.len() != n {
             return Err(SelectError::Length {
                 file: file.to_owned(),
-                channel: c.name.clone(),
+                channel: c.name().to_owned(),
                 role: ROLES[role],
-                len: c.data.len(),
-                reference: reference.name.clone(),
+                len: c.len(),
+                reference: reference.name().to_owned(),
                 expected: n,
             });
         }
-        let conv = conversion(ROLE_QUANTITIES[role], c.unit.as_deref()).map_err(|source| {
+        let conv = conversion(ROLE_QUANTITIES[role], c.unit()).map_err(|source| {
             SelectError::Unit {
                 file: file.to_owned(),
-                channel: c.name.clone(),
+                channel: c.name().to_owned(),
                 role: ROLES[role],
                 source,
             }
@@ -303,7 +309,7 @@ fn plan(table: &Table, map: &ColumnMap) -> Result<Plan, SelectError> {
             check(0, i)?;
             None
         }
-        None => match reference.axis.or(table.channels[z].axis) {
+        None => match reference.axis().or(channels[z].axis()) {
             Some(axis) if !map.explicit || map.names[0] == ROLES[0] => Some((axis, n)),
             _ => {
                 return Err(SelectError::NoTime {
@@ -345,9 +351,9 @@ fn plan(table: &Table, map: &ColumnMap) -> Result<Plan, SelectError> {
     Ok(Plan { order, axis, speed })
 }
 
-/// The table's channel names for a message, at most 20.
-fn available(table: &Table) -> String {
-    let names: Vec<&str> = table.channels.iter().map(|c| c.name.as_str()).collect();
+/// The channel names for a message, at most 20.
+fn available<C: Described>(channels: &[C]) -> String {
+    let names: Vec<&str> = channels.iter().map(C::name).collect();
     if names.is_empty() {
         return "no channels".to_owned();
     }

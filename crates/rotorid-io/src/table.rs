@@ -13,9 +13,13 @@ pub struct TimeAxis {
 impl TimeAxis {
     /// The times of the first `n` samples \[s\]: `start + i * increment`.
     pub fn times(&self, n: usize) -> Vec<f64> {
-        (0..n)
-            .map(|i| self.start + i as f64 * self.increment)
-            .collect()
+        (0..n).map(|i| self.time(i)).collect()
+    }
+
+    /// The time of sample `i` \[s\]: `start + i * increment`.
+    #[inline]
+    pub fn time(&self, i: usize) -> f64 {
+        self.start + i as f64 * self.increment
     }
 }
 
@@ -33,6 +37,59 @@ pub struct Channel {
     pub data: Vec<f64>,
     /// The time axis the file implies for this channel, if any.
     pub axis: Option<TimeAxis>,
+}
+
+/// What a reader knows of a channel before reading its samples: a streaming reader's
+/// catalogue ([`crate::stream`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelInfo {
+    /// The name, as [`Channel::name`].
+    pub name: String,
+    /// The unit text the file gives, if any.
+    pub unit: Option<String>,
+    /// Number of samples.
+    pub len: usize,
+    /// The time axis the file implies for this channel, if any.
+    pub axis: Option<TimeAxis>,
+}
+
+/// A channel's name, unit, length and time axis, whether its samples are held
+/// ([`Channel`]) or still in the file ([`ChannelInfo`]): what selecting channels looks at.
+pub(crate) trait Described {
+    fn name(&self) -> &str;
+    fn unit(&self) -> Option<&str>;
+    fn len(&self) -> usize;
+    fn axis(&self) -> Option<TimeAxis>;
+}
+
+impl Described for Channel {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn unit(&self) -> Option<&str> {
+        self.unit.as_deref()
+    }
+    fn len(&self) -> usize {
+        self.data.len()
+    }
+    fn axis(&self) -> Option<TimeAxis> {
+        self.axis
+    }
+}
+
+impl Described for ChannelInfo {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn unit(&self) -> Option<&str> {
+        self.unit.as_deref()
+    }
+    fn len(&self) -> usize {
+        self.len
+    }
+    fn axis(&self) -> Option<TimeAxis> {
+        self.axis
+    }
 }
 
 /// The channels of one file.
@@ -58,14 +115,7 @@ impl Table {
 
     /// The index in [`Table::channels`] of the channel [`Table::channel`] finds.
     pub fn channel_index(&self, name: &str) -> Option<usize> {
-        if let Some(i) = self.channels.iter().position(|c| c.name == name) {
-            return Some(i);
-        }
-        let mut hits = self.candidate_indices(name);
-        match (hits.next(), hits.next()) {
-            (Some(i), None) => Some(i),
-            _ => None,
-        }
+        index_named(&self.channels, |c| &c.name, name)
     }
 
     /// Channels whose last component (after the last `.` or `/`) is `name`.
@@ -73,20 +123,37 @@ impl Table {
     where
         'a: 'n,
     {
-        self.candidate_indices(name).map(|i| &self.channels[i])
+        indices_short_named(&self.channels, |c| &c.name, name).map(|i| &self.channels[i])
     }
+}
 
-    /// The indices of [`Table::candidates`] in [`Table::channels`].
-    fn candidate_indices<'a, 'n>(&'a self, name: &'n str) -> impl Iterator<Item = usize> + 'n
-    where
-        'a: 'n,
-    {
-        self.channels
-            .iter()
-            .enumerate()
-            .filter(move |(_, c)| last_component(&c.name) == name)
-            .map(|(i, _)| i)
+/// The index of the item of `items` called `name` (`name_of` gives an item's name), as
+/// [`Table::channel_index`] finds it: an exact match, else the one short-name match.
+pub(crate) fn index_named<T>(items: &[T], name_of: impl Fn(&T) -> &str, name: &str) -> Option<usize> {
+    if let Some(i) = items.iter().position(|c| name_of(c) == name) {
+        return Some(i);
     }
+    let mut hits = indices_short_named(items, name_of, name);
+    match (hits.next(), hits.next()) {
+        (Some(i), None) => Some(i),
+        _ => None,
+    }
+}
+
+/// The indices of the items of `items` whose name's last component is `name`.
+pub(crate) fn indices_short_named<'a, 'n, T>(
+    items: &'a [T],
+    name_of: impl Fn(&T) -> &str + 'n,
+    name: &'n str,
+) -> impl Iterator<Item = usize> + 'n
+where
+    'a: 'n,
+{
+    items
+        .iter()
+        .enumerate()
+        .filter(move |(_, c)| last_component(name_of(c)) == name)
+        .map(|(i, _)| i)
 }
 
 /// The part of a channel name after its last `.` or `/`.

@@ -1,0 +1,227 @@
+//! Records read a block of rows at a time, for formats whose layout allows it (TDMS
+//! segments, Parquet row groups and pages): memory then holds a few blocks, never the
+//! record, so a recording of any length can be identified.
+//!
+//! A [`RowBlocks`] reader first reads the file's catalogue (each channel's name, unit,
+//! length and time axis: [`ChannelInfo`]), checking the file's structure as the whole-file
+//! reader does; then it gives the rows of the channels asked for, in order, a block at a
+//! time. [`SiBlocks`] picks the channels that play t, x, z, phi, phi_dot, phi_ddot by the
+//! same rules and checks as [`crate::select()`] (it plans on the catalogue, before any
+//! sample is read), and converts each block to SI with the same conversions; so the samples
+//! are the ones `select(read_table(..))` gives, bit for bit, in blocks.
+//!
+//! [`open_blocks`] opens a file this way when its format streams (`None` otherwise: read
+//! it whole with [`crate::read_table`]).
+
+use std::path::Path;
+
+use crate::error::ReadError;
+use crate::format::Format;
+use crate::select::{plan, ColumnMap, SelectError, Used, ROLES};
+use crate::table::{ChannelInfo, TimeAxis};
+use crate::units::Conversion;
+
+/// Rows a block holds at most by default: 65,536 rows of six channels are 3 MiB.
+pub const DEFAULT_BLOCK_ROWS: usize = 1 << 16;
+
+/// A file read a block of rows at a time (module doc).
+pub trait RowBlocks: Send {
+    /// The file's name, for messages.
+    fn file(&self) -> &str;
+
+    /// The numeric channels, in file order, as the whole-file reader lists them.
+    fn channels(&self) -> &[ChannelInfo];
+
+    /// What the reader has to tell about the file that is not an error, as
+    /// [`crate::Table::notes`].
+    fn notes(&self) -> &[String];
+
+    /// Appends the next rows of the channels `wanted` (indices into
+    /// [`channels`](Self::channels), distinct, all of one length) to `out` (`out[k]` for
+    /// `wanted[k]`): the same number of rows to each, at most `max_rows` (>= 1), and
+    /// returns it; 0 once every row was given. `wanted` is the same at every call. An error
+    /// names the file, the channel and the byte offset, as the whole-file reader's does.
+    fn next_rows(
+        &mut self,
+        wanted: &[usize],
+        max_rows: usize,
+        out: &mut [Vec<f64>],
+    ) -> Result<usize, ReadError>;
+}
+
+/// The file at `path` read a block at a time, when its format allows it (TDMS, Parquet);
+/// `None` for the others.
+pub fn open_blocks(path: impl AsRef<Path>) -> Result<Option<Box<dyn RowBlocks>>, ReadError> {
+    let path = path.as_ref();
+    let file = path.display().to_string();
+    match Format::from_path(path)? {
+        // (the readers that stream join here)
+        _ => {
+            let _ = file;
+            Ok(None)
+        }
+    }
+}
+
+/// One block of the record in SI: rows `first..first + len` of t \[s\], x, z \[m\] and,
+/// when the file has them, phi \[rad\], phi_dot \[rad/s\], phi_ddot \[rad/s^2\].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SiBlock {
+    /// Index of the block's first row in the record.
+    pub first: usize,
+    /// Time stamps \[s\].
+    pub t: Vec<f64>,
+    /// Horizontal displacement \[m\].
+    pub x: Vec<f64>,
+    /// Vertical displacement \[m\].
+    pub z: Vec<f64>,
+    /// phi \[rad\], phi_dot \[rad/s\], phi_ddot \[rad/s^2\].
+    pub speed: Option<[Vec<f64>; 3]>,
+}
+
+impl SiBlock {
+    /// Rows in the block.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True for a block of no rows.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+}
+
+/// The channels of a [`RowBlocks`] reader that play t, x, z, phi, phi_dot, phi_ddot, in SI,
+/// a block at a time (module doc).
+pub struct SiBlocks {
+    inner: Box<dyn RowBlocks>,
+    /// (role, position in `wanted`, conversion), in the order of [`crate::select()`].
+    order: Vec<(usize, usize, Conversion)>,
+    /// The distinct channels read.
+    wanted: Vec<usize>,
+    /// t from the file's time axis.
+    axis: Option<TimeAxis>,
+    speed: bool,
+    used: Vec<Used>,
+    len: usize,
+    /// Rows given so far.
+    done: usize,
+}
+
+impl SiBlocks {
+    /// The channels of `inner` that play the roles of `map`, checked on its catalogue with
+    /// the checks and messages of [`crate::select()`].
+    pub fn new(inner: Box<dyn RowBlocks>, map: &ColumnMap) -> Result<Self, SelectError> {
+        let plan = plan(inner.file(), inner.channels(), map)?;
+        let mut wanted: Vec<usize> = Vec::with_capacity(plan.order.len());
+        let mut order = Vec::with_capacity(plan.order.len());
+        let mut used = Vec::with_capacity(plan.order.len());
+        for &(role, i, conv) in &plan.order {
+            let k = match wanted.iter().position(|&w| w == i) {
+                Some(k) => k,
+                None => {
+                    wanted.push(i);
+                    wanted.len() - 1
+                }
+            };
+            order.push((role, k, conv));
+            used.push(Used {
+                role: ROLES[role],
+                channel: inner.channels()[i].name.clone(),
+                conversion: conv,
+            });
+        }
+        // x is planned first: its length is the record's
+        let len = inner.channels()[plan.order[0].1].len;
+        Ok(Self {
+            inner,
+            order,
+            wanted,
+            axis: plan.axis.map(|(a, _)| a),
+            speed: plan.speed,
+            used,
+            len,
+            done: 0,
+        })
+    }
+
+    /// The file's name.
+    pub fn file(&self) -> &str {
+        self.inner.file()
+    }
+
+    /// What the reader noted about the file (see [`RowBlocks::notes`]).
+    pub fn notes(&self) -> &[String] {
+        self.inner.notes()
+    }
+
+    /// The channel that plays each role, with its conversion (as [`crate::SiColumns::used`]).
+    pub fn used(&self) -> &[Used] {
+        &self.used
+    }
+
+    /// True when t comes from the file's time axis.
+    pub fn time_from_axis(&self) -> bool {
+        self.axis.is_some()
+    }
+
+    /// True when the file has phi, phi_dot and phi_ddot.
+    pub fn has_speed(&self) -> bool {
+        self.speed
+    }
+
+    /// Rows in the record.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True for a record of no rows.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The next block of at most `max_rows` (>= 1) rows, `None` after the last.
+    pub fn next_block(&mut self, max_rows: usize) -> Result<Option<SiBlock>, ReadError> {
+        let mut raw: Vec<Vec<f64>> = self
+            .wanted
+            .iter()
+            .map(|_| Vec::with_capacity(max_rows.min(self.len - self.done)))
+            .collect();
+        let n = self
+            .inner
+            .next_rows(&self.wanted, max_rows.max(1), &mut raw)?;
+        if n == 0 {
+            return Ok(None);
+        }
+        // each channel's buffer becomes its (first) role's column, converted in place; a
+        // channel that plays two roles is copied for the first
+        let mut uses = vec![0_usize; raw.len()];
+        for &(_, k, _) in &self.order {
+            uses[k] += 1;
+        }
+        let mut out: [Vec<f64>; 6] = Default::default();
+        for &(role, k, conv) in &self.order {
+            uses[k] -= 1;
+            let mut data = if uses[k] == 0 {
+                std::mem::take(&mut raw[k])
+            } else {
+                raw[k].clone()
+            };
+            conv.apply_all(&mut data);
+            out[role] = data;
+        }
+        let first = self.done;
+        self.done += n;
+        let [t, x, z, phi, phi_dot, phi_ddot] = out;
+        Ok(Some(SiBlock {
+            first,
+            t: match self.axis {
+                Some(a) => (first..first + n).map(|i| a.time(i)).collect(),
+                None => t,
+            },
+            x,
+            z,
+            speed: self.speed.then_some([phi, phi_dot, phi_ddot]),
+        }))
+    }
+}
