@@ -291,14 +291,13 @@ pub(crate) fn plan<C: Described>(
                 expected: n,
             });
         }
-        let conv = conversion(ROLE_QUANTITIES[role], c.unit()).map_err(|source| {
-            SelectError::Unit {
+        let conv =
+            conversion(ROLE_QUANTITIES[role], c.unit()).map_err(|source| SelectError::Unit {
                 file: file.to_owned(),
                 channel: c.name().to_owned(),
                 role: ROLES[role],
                 source,
-            }
-        })?;
+            })?;
         order.push((role, i, conv));
         Ok(())
     };
