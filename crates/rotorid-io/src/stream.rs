@@ -55,6 +55,7 @@ pub fn open_blocks(path: impl AsRef<Path>) -> Result<Option<Box<dyn RowBlocks>>,
     let path = path.as_ref();
     let file = path.display().to_string();
     match Format::from_path(path)? {
+        Format::Tdms => Ok(Some(Box::new(crate::tdms::open_blocks(&file, path)?))),
         // (the readers that stream join here)
         _ => {
             let _ = file;

@@ -1,0 +1,403 @@
+//! TDMS files read a block of rows at a time ([`crate::stream::RowBlocks`]).
+//!
+//! [`open_blocks`] makes one pass over the file's segments that reads their lead-ins and
+//! metadata only, never their raw data: the same pass, with the same checks and messages,
+//! as the whole-file reader's ([`super::read_file`]), down to the layout of each segment's
+//! raw data (chunks that divide it, DAQmx buffers that agree, interleaved channels of one
+//! count) and the notes on an interrupted last segment. Properties set in any segment
+//! count, the last value winning, so the catalogue (each numeric `group/channel`, its
+//! `unit_string`, its length and its time axis) and the scaling are the whole file's; what
+//! the whole-file reader refuses on those grounds is refused here, at open.
+//!
+//! It keeps, per channel, where its values lie: for each segment that holds some, the
+//! chunk size and count and the runs of values in a chunk (one for plain or interleaved
+//! data, one per DAQmx scaler), a few dozen bytes per channel and segment.
+//! [`next_rows`](crate::stream::RowBlocks::next_rows) then reads each channel asked for
+//! from where it stopped, a block of at most 256 KiB of the file at a time (the reads of
+//! the whole-file reader), scales the block as it is read and hands out the rows every
+//! channel asked for has. Every NI scale rotorid applies (`tdms/scaling.rs`) works value
+//! by value, so a block scales as the whole channel does, bit for bit: none needs the
+//! whole channel, and there is no fallback. Memory holds the catalogue and, per channel
+//! asked for, a queue of fewer than `max_rows` values plus one block (at most 2^18 values,
+//! 2 MiB, for a one-byte type; 32,768 values, 256 KiB, for `f64`), never the channel.
+//!
+//! Differences from the whole-file reader, all on files both refuse: a fault in the layout
+//! of a later segment's raw data (interleaved channels of unequal counts among them), or a
+//! scaling it refuses, is reported at open, where the whole-file reader reports first a
+//! sample of an earlier segment that `f64` cannot hold ([`ReadError::InexactInteger`],
+//! found only when samples are read); and only the channels asked for are read, so such a
+//! sample in another channel (or in values the channel's scaling does not use) is not
+//! reported, and of two channels that have one the first asked for is named.
+
+use std::collections::HashMap;
+
+use super::{
+    no_channels, raw_cursor, source, unequal, unequal_error, Chain, DaqmxLayout, Input, Layout,
+    Walk, BLOCK,
+};
+use crate::error::ReadError;
+use crate::format::{DiskFile, Source};
+use crate::num::{Dtype, Endian};
+use crate::table::ChannelInfo;
+
+/// Values of one channel in each chunk of a segment: `count` of them, the first at byte
+/// `at` of the file in the segment's first chunk, `stride` bytes apart.
+#[derive(Debug, Clone, Copy)]
+struct Run {
+    at: u64,
+    count: u64,
+    stride: u64,
+    dtype: Dtype,
+}
+
+/// One channel's values in one segment: in each of `chunks` chunks of `chunk` bytes, its
+/// runs in order.
+#[derive(Debug, Clone)]
+struct Part {
+    e: Endian,
+    chunk: u64,
+    chunks: u64,
+    runs: Vec<Run>,
+}
+
+impl Part {
+    /// Values in the segment (at most one per byte of its raw data).
+    fn len(&self) -> u64 {
+        let per_chunk = self
+            .runs
+            .iter()
+            .map(|r| r.count)
+            .fold(0u64, u64::saturating_add);
+        per_chunk.saturating_mul(self.chunks)
+    }
+}
+
+/// A channel being read: where its values lie, where it stopped, and what it read ahead.
+struct Stream {
+    /// `group/channel`, for messages.
+    name: String,
+    parts: Vec<Part>,
+    /// Where it stopped: part, chunk, run, value of the run.
+    part: usize,
+    chunk: u64,
+    run: usize,
+    first: u64,
+    /// Values read so far (the index of the next one in the channel).
+    read: u64,
+    /// Values read and scaled, not yet handed out.
+    queue: Vec<f64>,
+    /// Values handed out.
+    given: usize,
+    /// The scales applied to its values, if any.
+    chain: Option<Chain>,
+}
+
+impl Stream {
+    /// Reads the channel's next block (at most [`BLOCK`] bytes of the file) onto its queue,
+    /// scaled; `false` when it has no more.
+    fn refill(
+        &mut self,
+        src: &DiskFile<'static>,
+        file: &str,
+        scratch: &mut Vec<u8>,
+    ) -> Result<bool, ReadError> {
+        loop {
+            let Some(part) = self.parts.get(self.part) else {
+                return Ok(false);
+            };
+            if self.chunk >= part.chunks {
+                (self.part, self.chunk, self.run, self.first) = (self.part + 1, 0, 0, 0);
+                continue;
+            }
+            let Some(run) = part.runs.get(self.run) else {
+                (self.chunk, self.run, self.first) = (self.chunk + 1, 0, 0);
+                continue;
+            };
+            if self.first >= run.count {
+                (self.run, self.first) = (self.run + 1, 0);
+                continue;
+            }
+            let per = (BLOCK / run.stride.max(1)).max(1);
+            let m = per.min(run.count - self.first);
+            let at = run.at + self.chunk * part.chunk + self.first * run.stride;
+            let start = self.queue.len();
+            crate::num::samples_at(
+                src,
+                file,
+                &self.name,
+                at,
+                self.read,
+                m,
+                run.stride,
+                run.dtype,
+                part.e,
+                scratch,
+                &mut self.queue,
+            )?;
+            if let Some(c) = &self.chain {
+                c.apply_in_place(&mut self.queue[start..]);
+            }
+            self.read += m;
+            self.first += m;
+            return Ok(true);
+        }
+    }
+}
+
+/// A TDMS file read a block of rows at a time ([module doc](self)).
+pub struct TdmsBlocks {
+    file: String,
+    src: DiskFile<'static>,
+    channels: Vec<ChannelInfo>,
+    notes: Vec<String>,
+    /// One per channel of `channels`.
+    streams: Vec<Stream>,
+    scratch: Vec<u8>,
+    /// The most bytes the channels' queues have held at once.
+    peak: usize,
+}
+
+/// Opens the TDMS file at `path` (`file` names it in messages) to be read a block of rows
+/// at a time: reads and checks every segment's lead-in and metadata ([module doc](self)). Refuses
+/// what [`super::read_file`] refuses on those grounds, with the same messages.
+pub fn open_blocks(file: &str, path: &std::path::Path) -> Result<TdmsBlocks, ReadError> {
+    let src = DiskFile::open_owned(file, path)?;
+    let size = src.size();
+    let mut w = Walk::default();
+    // Where each object's values lie, for each input they may feed.
+    let mut parts: HashMap<(usize, Input), Vec<Part>> = HashMap::new();
+    let mut seg = 0u64;
+    while seg < size {
+        let (end, raw) = w.segment(file, &src, seg)?;
+        if let Some((r, l)) = raw {
+            // this segment's runs of each object and input, in reading order
+            let mut here: Vec<((usize, Input), Vec<Run>)> = Vec::new();
+            let mut add =
+                |key: (usize, Input), run: Run| match here.iter_mut().find(|(k, _)| *k == key) {
+                    Some((_, runs)) => runs.push(run),
+                    None => here.push((key, vec![run])),
+                };
+            let (chunk, chunks) = match l {
+                Layout::Plain {
+                    present,
+                    chunk,
+                    chunks,
+                } => {
+                    let mut at = r.start;
+                    for &(k, i) in &present {
+                        if let Some(dtype) = i.dtype {
+                            let run = Run {
+                                at,
+                                count: i.count,
+                                stride: i.size,
+                                dtype,
+                            };
+                            add((k, Input::Stored), run);
+                        }
+                        at += i.bytes;
+                    }
+                    (chunk, chunks)
+                }
+                Layout::Interleaved {
+                    present,
+                    chunk,
+                    chunks,
+                } => {
+                    if let Some(j) = unequal(&present) {
+                        return Err(unequal_error(&raw_cursor(&r), &present, j, &w.objects));
+                    }
+                    let row: u64 = present.iter().map(|(_, i)| i.size).sum();
+                    let mut col = 0;
+                    for &(k, i) in &present {
+                        if let Some(dtype) = i.dtype {
+                            let run = Run {
+                                at: r.start + col,
+                                count: i.count,
+                                stride: row,
+                                dtype,
+                            };
+                            add((k, Input::Stored), run);
+                        }
+                        col += i.size;
+                    }
+                    (chunk, chunks)
+                }
+                Layout::Daqmx(DaqmxLayout {
+                    present,
+                    rows,
+                    widths,
+                    scalers,
+                    chunk,
+                    chunks,
+                }) => {
+                    let mut base = r.start;
+                    for (b, (&count, &width)) in rows.iter().zip(&widths).enumerate() {
+                        let width = u64::from(width);
+                        for (&(k, _), scalers) in present.iter().zip(&scalers) {
+                            let o = &mut w.objects[k];
+                            for s in scalers.iter().filter(|s| s.buffer as usize == b) {
+                                let Some(dtype) = s.dtype else { continue };
+                                let input = if o.daqmx_raw {
+                                    // (the whole-file reader's list of this object's
+                                    // scalers, without their values)
+                                    super::scaler_values(o, s.id);
+                                    Input::Scaler(s.id)
+                                } else {
+                                    Input::Stored
+                                };
+                                let run = Run {
+                                    at: base + u64::from(s.offset),
+                                    count,
+                                    stride: width,
+                                    dtype,
+                                };
+                                add((k, input), run);
+                            }
+                        }
+                        base += count * width;
+                    }
+                    (chunk, chunks)
+                }
+            };
+            for (key, runs) in here {
+                let runs: Vec<Run> = runs.into_iter().filter(|r| r.count > 0).collect();
+                if !runs.is_empty() {
+                    parts.entry(key).or_default().push(Part {
+                        e: r.e,
+                        chunk,
+                        chunks,
+                        runs,
+                    });
+                }
+            }
+        }
+        seg = end;
+    }
+    let root = w.root();
+    let mut channels = Vec::new();
+    let mut streams = Vec::new();
+    for k in w.channels() {
+        let (input, chain) = source(file, &w.objects, k, root)?;
+        let axis = super::axis(file, &w.objects[k])?;
+        let o = &w.objects[k];
+        let parts = parts.remove(&(k, input)).unwrap_or_default();
+        let len = parts.iter().map(Part::len).fold(0u64, u64::saturating_add);
+        channels.push(ChannelInfo {
+            name: o.name(),
+            unit: o.unit.clone(),
+            len: usize::try_from(len).unwrap_or(usize::MAX),
+            axis,
+        });
+        streams.push(Stream {
+            name: o.name(),
+            parts,
+            part: 0,
+            chunk: 0,
+            run: 0,
+            first: 0,
+            read: 0,
+            queue: Vec::new(),
+            given: 0,
+            chain,
+        });
+    }
+    if channels.is_empty() {
+        return Err(no_channels(file));
+    }
+    Ok(TdmsBlocks {
+        file: file.to_string(),
+        src,
+        channels,
+        notes: w.notes,
+        streams,
+        scratch: Vec::new(),
+        peak: 0,
+    })
+}
+
+impl TdmsBlocks {
+    /// The most bytes the queues of the channels read have held at once (their capacity):
+    /// at most, per channel read, `max_rows` values plus one block of at most 2^18 values,
+    /// twice over for a queue's growth, at 8 bytes a value ([module doc](self)).
+    pub fn peak_queued_bytes(&self) -> usize {
+        self.peak
+    }
+
+    fn asked(&self, wanted: &[usize], out: &[Vec<f64>]) -> Result<(), ReadError> {
+        let n = self.channels.len();
+        let distinct = wanted
+            .iter()
+            .enumerate()
+            .all(|(j, &k)| k < n && !wanted[..j].contains(&k));
+        if distinct && wanted.len() == out.len() {
+            return Ok(());
+        }
+        Err(ReadError::Invalid {
+            file: self.file.clone(),
+            channel: None,
+            offset: 0,
+            what: "channels asked for".into(),
+            found: format!("{wanted:?} with {} lists to fill", out.len()),
+            allowed: format!("distinct indices below {n}, one list each"),
+        })
+    }
+}
+
+impl crate::stream::RowBlocks for TdmsBlocks {
+    fn file(&self) -> &str {
+        &self.file
+    }
+
+    fn channels(&self) -> &[ChannelInfo] {
+        &self.channels
+    }
+
+    fn notes(&self) -> &[String] {
+        &self.notes
+    }
+
+    fn next_rows(
+        &mut self,
+        wanted: &[usize],
+        max_rows: usize,
+        out: &mut [Vec<f64>],
+    ) -> Result<usize, ReadError> {
+        self.asked(wanted, out)?;
+        let n = wanted
+            .iter()
+            .map(|&k| self.channels[k].len - self.streams[k].given)
+            .min()
+            .unwrap_or(0)
+            .min(max_rows.max(1));
+        if n == 0 {
+            return Ok(0);
+        }
+        for &k in wanted {
+            let s = &mut self.streams[k];
+            while s.queue.len() < n {
+                if !s.refill(&self.src, &self.file, &mut self.scratch)? {
+                    // (the catalogue counted the values the parts hold: not reached)
+                    return Err(ReadError::Truncated {
+                        file: self.file.clone(),
+                        channel: Some(s.name.clone()),
+                        offset: self.src.size(),
+                        what: "TDMS channel values".into(),
+                        need: n as u64,
+                        available: s.queue.len() as u64,
+                    });
+                }
+            }
+        }
+        let held: usize = wanted
+            .iter()
+            .map(|&k| self.streams[k].queue.capacity())
+            .sum();
+        self.peak = self.peak.max(held * 8);
+        for (j, &k) in wanted.iter().enumerate() {
+            let s = &mut self.streams[k];
+            out[j].extend(s.queue.drain(..n));
+            s.given += n;
+        }
+        Ok(n)
+    }
+}
