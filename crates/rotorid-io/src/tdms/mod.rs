@@ -1169,6 +1169,8 @@ mod tests {
         let mem = read("x.tdms", bytes);
         let disk = read_file("x.tdms", &path);
         assert_eq!(format!("{mem:?}"), format!("{disk:?}"));
+        // and streamed, block by block, alike
+        stream::check::agrees_exactly(bytes, &mem);
         mem
     }
 
@@ -1743,6 +1745,156 @@ mod tests {
             Err(ReadError::Invalid { what, .. }) => assert_eq!(what, "TDMS DAQmx scaler"),
             other => panic!("{other:?}"),
         }
+    }
+
+    /// A segment of table of contents `toc` (as given), byte order `e`, holding `meta`
+    /// and `raw`.
+    fn raw_segment(toc: u32, e: Endian, meta: &[u8], raw: &[u8]) -> Vec<u8> {
+        let u64b = |v: u64| match e {
+            Endian::Little => v.to_le_bytes(),
+            Endian::Big => v.to_be_bytes(),
+        };
+        let mut f = b"TDSm".to_vec();
+        f.extend(toc.to_le_bytes());
+        f.extend(match e {
+            Endian::Little => 4713u32.to_le_bytes(),
+            Endian::Big => 4713u32.to_be_bytes(),
+        });
+        f.extend(u64b((meta.len() + raw.len()) as u64));
+        f.extend(u64b(meta.len() as u64));
+        f.extend(meta);
+        f.extend(raw);
+        f
+    }
+
+    #[test]
+    fn streaming_follows_object_lists_across_segments_of_every_layout() {
+        // Each file is read whole, from memory and disk, and streamed by blocks of 1, 7,
+        // 4096 and all rows (both): the same catalogue, notes and values bit for bit.
+        let f64s = |v: &[f64]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+        let i16s = |v: &[i16]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+        // b is i16 codes scaled by its group's linear scale; a has a unit and a time axis
+        let group = {
+            let path = "/'g'";
+            let mut b = 1u32.to_le_bytes().to_vec();
+            b.extend((path.len() as u32).to_le_bytes());
+            b.extend(path.as_bytes());
+            b.extend(0xFFFF_FFFFu32.to_le_bytes());
+            b.extend(props_bytes(&[
+                ("NI_Number_Of_Scales", 3, 1i32.to_le_bytes().to_vec()),
+                ("NI_Scale[0]_Scale_Type", 0x20, text("Linear")),
+                (
+                    "NI_Scale[0]_Linear_Slope",
+                    10,
+                    0.5f64.to_le_bytes().to_vec(),
+                ),
+                (
+                    "NI_Scale[0]_Linear_Y_Intercept",
+                    10,
+                    (-3.0f64).to_le_bytes().to_vec(),
+                ),
+            ]));
+            b
+        };
+        let a_props = [
+            ("unit_string", 0x20, text("um")),
+            ("wf_increment", 10, 0.001f64.to_le_bytes().to_vec()),
+        ];
+        let mut meta = 2u32.to_le_bytes().to_vec();
+        meta.extend(channel_meta("a", 10, 3, &a_props));
+        meta.extend(channel_meta("b", 2, 2, &[]));
+        // (the group's scale comes in a later segment: the whole file's properties count)
+        let mut f = Vec::new();
+        let seg1_raw = [f64s(&[1.0, 2.0, 3.0]), i16s(&[10, 11])].concat();
+        f.extend(raw_segment(
+            TOC_META | TOC_NEW_LIST | TOC_RAW,
+            Endian::Little,
+            &meta,
+            &seg1_raw,
+        ));
+        // 2: no metadata, the same list, two chunks
+        let seg2_raw = [
+            f64s(&[4.0, 5.0, 6.0]),
+            i16s(&[12, 13]),
+            f64s(&[7.0, 8.0, 9.0]),
+            i16s(&[14, 15]),
+        ]
+        .concat();
+        f.extend(raw_segment(TOC_RAW, Endian::Little, &[], &seg2_raw));
+        // 3: the list updated (not new): a as before (index 0), b without data, and the
+        // group's scale
+        let mut meta3 = 3u32.to_le_bytes().to_vec();
+        for (path, index) in [("/'g'/'a'", 0u32), ("/'g'/'b'", 0xFFFF_FFFF)] {
+            meta3.extend((path.len() as u32).to_le_bytes());
+            meta3.extend(path.as_bytes());
+            meta3.extend(index.to_le_bytes());
+            meta3.extend(0u32.to_le_bytes());
+        }
+        meta3.extend_from_slice(&group[4..]);
+        f.extend(raw_segment(
+            TOC_META | TOC_RAW,
+            Endian::Little,
+            &meta3,
+            &f64s(&[10.0, 11.0, 12.0]),
+        ));
+        // 4: interleaved, a new list: b then a, 2 rows
+        let mut meta4 = 2u32.to_le_bytes().to_vec();
+        meta4.extend(channel_meta("b", 2, 2, &[]));
+        meta4.extend(channel_meta("a", 10, 2, &[]));
+        let mut rows = Vec::new();
+        for (b, a) in [(16i16, 13.0f64), (17, 14.0)] {
+            rows.extend(b.to_le_bytes());
+            rows.extend(a.to_le_bytes());
+        }
+        f.extend(raw_segment(
+            TOC_META | TOC_NEW_LIST | TOC_RAW | TOC_INTERLEAVED,
+            Endian::Little,
+            &meta4,
+            &rows,
+        ));
+        // 5: big endian, a alone, a value 100 000 rows long (blocks of 256 KiB)
+        let n = 100_000u64;
+        let path = "/'g'/'a'";
+        let mut meta5 = 1u32.to_be_bytes().to_vec();
+        meta5.extend((path.len() as u32).to_be_bytes());
+        meta5.extend(path.as_bytes());
+        meta5.extend(20u32.to_be_bytes());
+        meta5.extend(10u32.to_be_bytes());
+        meta5.extend(1u32.to_be_bytes());
+        meta5.extend(n.to_be_bytes());
+        meta5.extend(0u32.to_be_bytes());
+        let big: Vec<u8> = (0..n)
+            .flat_map(|k| (k as f64 * 1.5).to_be_bytes())
+            .collect();
+        f.extend(raw_segment(
+            TOC_META | TOC_NEW_LIST | TOC_RAW | TOC_BIG_ENDIAN,
+            Endian::Big,
+            &meta5,
+            &big,
+        ));
+        let t = both(&f).unwrap();
+        // (the group's scale applies to both)
+        let scale = |v: f64| v * 0.5 - 3.0;
+        let a = &t.channels[0].data;
+        assert_eq!(a.len(), 14 + n as usize);
+        let first: Vec<f64> = (1..=14).map(|v| scale(f64::from(v))).collect();
+        assert_eq!(a[..14], first);
+        assert_eq!(a[14 + 99_999], scale(99_999.0 * 1.5));
+        let b: Vec<f64> = (10..18).map(|c| scale(f64::from(c))).collect();
+        assert_eq!(t.channels[1].data, b);
+        assert_eq!(t.channels[0].unit.as_deref(), Some("um"));
+        // and left open by its writer, cut inside the big-endian segment: its whole rows
+        let open = {
+            let mut g = f.clone();
+            let last = g.len() - big.len() - meta5.len() - 28;
+            g[last + 12..last + 20].copy_from_slice(&u64::MAX.to_be_bytes());
+            g.truncate(g.len() - 8 * 50_000 - 3);
+            g
+        };
+        let t = both(&open).unwrap();
+        // (one chunk of 100 000 values: less than a chunk is left, so no value of it)
+        assert_eq!(t.notes.len(), 1);
+        assert_eq!(t.channels[0].data[..], a[..14]);
     }
 
     /// `f` (one segment) as its writer leaves it when the recording is interrupted: the

@@ -401,3 +401,103 @@ impl crate::stream::RowBlocks for TdmsBlocks {
         Ok(n)
     }
 }
+
+#[cfg(test)]
+pub(super) mod check {
+    //! What the whole-file reader's tests check of every file they build: streamed, it
+    //! gives the same catalogue, notes and values, or an error.
+    use super::*;
+    use crate::stream::RowBlocks;
+    use crate::table::Table;
+
+    /// Block sizes streamed: one row, a few, many, all.
+    pub(crate) const MAX_ROWS: [usize; 4] = [1, 7, 4096, usize::MAX];
+
+    /// The channels of `b` (all of them, those of one length read together, as
+    /// [`RowBlocks::next_rows`] asks), `max_rows` rows at a time.
+    pub(crate) fn read_all(
+        b: &mut TdmsBlocks,
+        max_rows: usize,
+    ) -> Result<Vec<Vec<f64>>, ReadError> {
+        let lens: Vec<usize> = b.channels().iter().map(|c| c.len).collect();
+        let mut data = vec![Vec::new(); lens.len()];
+        let mut groups: Vec<usize> = lens.clone();
+        groups.sort_unstable();
+        groups.dedup();
+        for len in groups {
+            let wanted: Vec<usize> = (0..lens.len()).filter(|&k| lens[k] == len).collect();
+            let mut out = vec![Vec::new(); wanted.len()];
+            let mut total = 0;
+            loop {
+                let before: Vec<usize> = out.iter().map(Vec::len).collect();
+                let n = b.next_rows(&wanted, max_rows, &mut out)?;
+                for (o, was) in out.iter().zip(before) {
+                    assert_eq!(o.len(), was + n, "every channel gains the same rows");
+                }
+                assert!(n <= max_rows);
+                if n == 0 {
+                    break;
+                }
+                total += n;
+            }
+            assert_eq!(total, len, "the catalogue's length is what is read");
+            for (k, o) in wanted.into_iter().zip(out) {
+                data[k] = o;
+            }
+        }
+        // once done, nothing more
+        let all: Vec<usize> = (0..lens.len()).collect();
+        let mut out = vec![Vec::new(); lens.len()];
+        if lens.iter().all(|&l| l == lens[0]) {
+            assert_eq!(b.next_rows(&all, 5, &mut out)?, 0);
+        }
+        Ok(data)
+    }
+
+    fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    /// Streams the file at `path` with every block size of [`MAX_ROWS`] and checks it
+    /// against the whole-file reader's `want`: the same catalogue, notes and values bit
+    /// for bit; an error whenever it errs (the same one, but for the differences the
+    /// module doc lists). Returns how many of the errors differed in their text.
+    pub(crate) fn agrees(path: &std::path::Path, want: &Result<Table, ReadError>) -> usize {
+        let mut differ = 0;
+        for max_rows in MAX_ROWS {
+            let got = open_blocks("x.tdms", path).and_then(|mut b| {
+                let data = read_all(&mut b, max_rows)?;
+                Ok((b, data))
+            });
+            match (want, got) {
+                (Ok(t), Ok((b, data))) => {
+                    assert_eq!(b.channels().len(), t.channels.len());
+                    for ((info, c), d) in b.channels().iter().zip(&t.channels).zip(&data) {
+                        assert_eq!(info.name, c.name);
+                        assert_eq!(info.unit, c.unit);
+                        assert_eq!(info.len, c.data.len(), "{}", c.name);
+                        assert_eq!(info.axis, c.axis);
+                        assert_eq!(bits(d), bits(&c.data), "{} by {max_rows}", c.name);
+                    }
+                    assert_eq!(b.notes(), t.notes.as_slice());
+                }
+                (Err(e), Err(g)) => {
+                    if e.to_string() != g.to_string() {
+                        differ += 1;
+                    }
+                }
+                (Ok(_), Err(g)) => panic!("whole file read, streaming refused: {g}"),
+                (Err(e), Ok(_)) => panic!("whole file refused ({e}), streaming read"),
+            }
+        }
+        differ
+    }
+
+    /// [`agrees`] on `bytes`, written to a file, and no error text differs.
+    pub(crate) fn agrees_exactly(bytes: &[u8], want: &Result<Table, ReadError>) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.tdms");
+        std::fs::write(&path, bytes).unwrap();
+        assert_eq!(agrees(&path, want), 0, "{want:?}");
+    }
+}
