@@ -260,3 +260,63 @@ fn a_long_file_of_many_segments_streams_in_bounded_memory() {
     assert!(peak > 0 && peak <= bound, "{peak} > {bound}");
     assert!(peak * 4 < 2 * 8 * xs.len());
 }
+
+#[test]
+fn rotorid_io_open_blocks_streams_tdms_into_the_si_columns_select_gives() {
+    // through the registry (stream::open_blocks) and SiBlocks, by blocks of 1000 rows: the
+    // SI columns select(read_table(..)) gives, bit for bit, or the same refusal
+    use rotorid_io::{open_blocks, read_table, select, ColumnMap, SiBlocks};
+    let dir = tempfile::tempdir().unwrap();
+    let (mut compared, mut streamed) = (0, 0);
+    for (name, bytes) in files() {
+        let path = dir.path().join("x.tdms");
+        std::fs::write(&path, &bytes).unwrap();
+        let t = read_table(&path).unwrap();
+        // the default names, and the first channels (as t, x, z) of the first length that
+        // has three, by their full names
+        let mut maps = vec![ColumnMap::default()];
+        for c in &t.channels {
+            let same: Vec<&str> = t
+                .channels
+                .iter()
+                .filter(|d| d.data.len() == c.data.len())
+                .map(|d| d.name.as_str())
+                .collect();
+            if same.len() >= 3 {
+                maps.push(ColumnMap::parse(&same[..3].join(",")).unwrap());
+                break;
+            }
+        }
+        for map in &maps {
+            compared += 1;
+            let want = select(t.clone(), map);
+            let inner = open_blocks(&path).unwrap().expect("TDMS streams");
+            let got = SiBlocks::new(inner, map);
+            let (want, mut got) = match (want, got) {
+                (Ok(w), Ok(g)) => (w, g),
+                (Err(w), Err(g)) => {
+                    assert_eq!(w.to_string(), g.to_string(), "{name}");
+                    continue;
+                }
+                (w, g) => panic!(
+                    "{name}: select {:?}, streamed {:?}",
+                    w.map(|_| ()),
+                    g.map(|_| ())
+                ),
+            };
+            streamed += 1;
+            let (mut t_, mut x, mut z) = (Vec::new(), Vec::new(), Vec::new());
+            while let Some(b) = got.next_block(1000).unwrap() {
+                assert_eq!(b.first, x.len());
+                t_.extend(b.t);
+                x.extend(b.x);
+                z.extend(b.z);
+            }
+            assert_eq!(bits(&t_), bits(&want.t), "{name}");
+            assert_eq!(bits(&x), bits(&want.x), "{name}");
+            assert_eq!(bits(&z), bits(&want.z), "{name}");
+        }
+    }
+    eprintln!("{compared} selections compared, {streamed} streamed");
+    assert!(streamed >= 2, "{streamed}");
+}
