@@ -11,7 +11,8 @@
 //!
 //! It keeps, per channel, where its values lie: for each segment that holds some, the
 //! chunk size and count and the runs of values in a chunk (one for plain or interleaved
-//! data, one per DAQmx scaler), a few dozen bytes per channel and segment.
+//! data, one per DAQmx scaler), a few dozen bytes per channel and segment, or per run of
+//! segments of one layout (a recording written a block per segment keeps one).
 //! [`next_rows`](crate::stream::RowBlocks::next_rows) then reads each channel asked for
 //! from where it stopped, a block of at most 256 KiB of the file at a time (the reads of
 //! the whole-file reader), scales the block as it is read and hands out the rows every
@@ -50,25 +51,64 @@ struct Run {
     dtype: Dtype,
 }
 
-/// One channel's values in one segment: in each of `chunks` chunks of `chunk` bytes, its
-/// runs in order.
+/// One channel's values in one segment, or in `reps` segments of the same layout `step`
+/// bytes apart (a recording written a block per segment): in each of `chunks` chunks of
+/// `chunk` bytes of each, its runs in order.
 #[derive(Debug, Clone)]
 struct Part {
     e: Endian,
     chunk: u64,
     chunks: u64,
     runs: Vec<Run>,
+    reps: u64,
+    step: u64,
 }
 
 impl Part {
-    /// Values in the segment (at most one per byte of its raw data).
+    /// Values in the part (at most one per byte of its raw data).
     fn len(&self) -> u64 {
         let per_chunk = self
             .runs
             .iter()
             .map(|r| r.count)
             .fold(0u64, u64::saturating_add);
-        per_chunk.saturating_mul(self.chunks)
+        per_chunk
+            .saturating_mul(self.chunks)
+            .saturating_mul(self.reps)
+    }
+
+    /// Takes in `next`, the channel's part of the segment after this part's last, when it
+    /// repeats that segment's layout further on in the file (so that a file of many small
+    /// segments keeps a part per channel and layout, not per segment); false otherwise.
+    fn absorb(&mut self, next: &Part) -> bool {
+        let same = self.e == next.e
+            && self.chunk == next.chunk
+            && self.chunks == next.chunks
+            && self.runs.len() == next.runs.len()
+            && self
+                .runs
+                .iter()
+                .zip(&next.runs)
+                .all(|(a, b)| (a.count, a.stride, a.dtype) == (b.count, b.stride, b.dtype));
+        if !same {
+            return false;
+        }
+        // where the last segment absorbed has each run
+        let last = (self.reps - 1) * self.step;
+        let d = next.runs[0].at.checked_sub(self.runs[0].at + last);
+        let Some(d) = d.filter(|&d| d > 0 && (self.reps == 1 || d == self.step)) else {
+            return false;
+        };
+        let shifted = self
+            .runs
+            .iter()
+            .zip(&next.runs)
+            .all(|(a, b)| a.at + last + d == b.at);
+        if shifted {
+            self.step = d;
+            self.reps += 1;
+        }
+        shifted
     }
 }
 
@@ -77,7 +117,7 @@ struct Stream {
     /// `group/channel`, for messages.
     name: String,
     parts: Vec<Part>,
-    /// Where it stopped: part, chunk, run, value of the run.
+    /// Where it stopped: part, chunk (of all the part's segments), run, value of the run.
     part: usize,
     chunk: u64,
     run: usize,
@@ -105,7 +145,8 @@ impl Stream {
             let Some(part) = self.parts.get(self.part) else {
                 return Ok(false);
             };
-            if self.chunk >= part.chunks {
+            // (chunk counts the chunks of every segment of the part)
+            if self.chunk >= part.chunks.saturating_mul(part.reps) {
                 (self.part, self.chunk, self.run, self.first) = (self.part + 1, 0, 0, 0);
                 continue;
             }
@@ -119,7 +160,8 @@ impl Stream {
             }
             let per = (BLOCK / run.stride.max(1)).max(1);
             let m = per.min(run.count - self.first);
-            let at = run.at + self.chunk * part.chunk + self.first * run.stride;
+            let (rep, chunk) = (self.chunk / part.chunks, self.chunk % part.chunks);
+            let at = run.at + rep * part.step + chunk * part.chunk + self.first * run.stride;
             let start = self.queue.len();
             crate::num::samples_at(
                 src,
@@ -262,12 +304,18 @@ pub fn open_blocks(file: &str, path: &std::path::Path) -> Result<TdmsBlocks, Rea
             for (key, runs) in here {
                 let runs: Vec<Run> = runs.into_iter().filter(|r| r.count > 0).collect();
                 if !runs.is_empty() {
-                    parts.entry(key).or_default().push(Part {
+                    let part = Part {
                         e: r.e,
                         chunk,
                         chunks,
                         runs,
-                    });
+                        reps: 1,
+                        step: 0,
+                    };
+                    let list = parts.entry(key).or_default();
+                    if !list.last_mut().is_some_and(|last| last.absorb(&part)) {
+                        list.push(part);
+                    }
                 }
             }
         }
@@ -499,5 +547,68 @@ pub(super) mod check {
         let path = dir.path().join("x.tdms");
         std::fs::write(&path, bytes).unwrap();
         assert_eq!(agrees(&path, want), 0, "{want:?}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::check::{agrees, read_all};
+    use super::*;
+
+    /// A segment of a new object list: channels `(name, values)` of f64, contiguous.
+    fn segment(channels: &[(&str, &[f64])]) -> Vec<u8> {
+        let mut meta = (channels.len() as u32).to_le_bytes().to_vec();
+        let mut raw = Vec::new();
+        for (name, values) in channels {
+            let path = format!("/'g'/'{name}'");
+            meta.extend((path.len() as u32).to_le_bytes());
+            meta.extend(path.as_bytes());
+            meta.extend(20u32.to_le_bytes());
+            meta.extend(10u32.to_le_bytes());
+            meta.extend(1u32.to_le_bytes());
+            meta.extend((values.len() as u64).to_le_bytes());
+            meta.extend(0u32.to_le_bytes());
+            raw.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+        }
+        let mut f = b"TDSm".to_vec();
+        f.extend(0x0Eu32.to_le_bytes());
+        f.extend(4713u32.to_le_bytes());
+        f.extend(((meta.len() + raw.len()) as u64).to_le_bytes());
+        f.extend((meta.len() as u64).to_le_bytes());
+        f.extend(meta);
+        f.extend(raw);
+        f
+    }
+
+    #[test]
+    fn segments_of_one_layout_keep_one_part_and_read_as_many() {
+        // 30 segments of a and b, 5 values each; then 1 of 3 values; then 30 of 5 again
+        let mut f = Vec::new();
+        let mut v = 0.0;
+        let mut next = |n: usize| {
+            (0..n)
+                .map(|_| {
+                    v += 1.0;
+                    v
+                })
+                .collect::<Vec<f64>>()
+        };
+        for n in std::iter::repeat_n(5, 30)
+            .chain([3])
+            .chain(std::iter::repeat_n(5, 30))
+        {
+            let (a, b) = (next(n), next(n));
+            f.extend(segment(&[("a", &a), ("b", &b)]));
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.tdms");
+        std::fs::write(&path, &f).unwrap();
+        let mut b = open_blocks("x.tdms", &path).unwrap();
+        for s in &b.streams {
+            let reps: Vec<u64> = s.parts.iter().map(|p| p.reps).collect();
+            assert_eq!(reps, [30, 1, 30], "{}", s.name);
+        }
+        assert_eq!(read_all(&mut b, 4).unwrap()[0].len(), 303);
+        assert_eq!(agrees(&path, &super::super::read_file("x.tdms", &path)), 0);
     }
 }
