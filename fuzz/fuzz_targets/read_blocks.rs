@@ -31,18 +31,31 @@ fuzz_target!(|data: &[u8]| {
             return;
         }
     };
-    let wanted: Vec<usize> = (0..blocks.channels().len()).collect();
-    let mut got: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::new()).collect();
+    // every channel, those of one length together (a reader gives rows of channels of
+    // one length)
+    let lens: Vec<usize> = blocks.channels().iter().map(|c| c.len).collect();
+    let mut got: Vec<Vec<f64>> = lens.iter().map(|_| Vec::new()).collect();
     let block = usize::from(*size) * 97 + 1;
-    let streamed = loop {
-        match blocks.next_rows(&wanted, block, &mut got) {
-            Ok(0) => break Ok(()),
-            Ok(n) => assert!(n <= block),
-            Err(e) => break Err(e),
+    let mut groups = lens.clone();
+    groups.sort_unstable();
+    groups.dedup();
+    let streamed = groups.into_iter().try_for_each(|len| {
+        let wanted: Vec<usize> = (0..lens.len()).filter(|&k| lens[k] == len).collect();
+        let mut out = vec![Vec::new(); wanted.len()];
+        loop {
+            let n = blocks.next_rows(&wanted, block, &mut out)?;
+            assert!(n <= block && out.iter().all(|o| o.len() == out[0].len()));
+            if n == 0 {
+                break;
+            }
         }
-    };
+        for (k, o) in wanted.into_iter().zip(out) {
+            got[k] = o;
+        }
+        Ok(())
+    });
     match (whole, streamed) {
-        (Ok(t), Ok(())) => {
+        (Ok(t), Ok::<(), rotorid_io::ReadError>(())) => {
             assert_eq!(t.channels.len(), blocks.channels().len());
             for ((c, info), d) in t.channels.iter().zip(blocks.channels()).zip(&got) {
                 assert_eq!(

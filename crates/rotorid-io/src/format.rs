@@ -102,7 +102,7 @@ pub fn read_bytes(format: Format, file: &str, bytes: &[u8]) -> Result<Table, Rea
 
 /// A file opened for reading at offsets, with its size; errors name `file`.
 pub(crate) struct DiskFile<'a> {
-    file: &'a str,
+    file: Cow<'a, str>,
     f: std::fs::File,
     /// Size \[bytes\].
     pub size: u64,
@@ -113,7 +113,22 @@ impl<'a> DiskFile<'a> {
     pub fn open(file: &'a str, path: &Path) -> Result<Self, ReadError> {
         let f = std::fs::File::open(path).map_err(|e| Self::io(file, e))?;
         let size = f.metadata().map_err(|e| Self::io(file, e))?.len();
-        Ok(Self { file, f, size })
+        Ok(Self {
+            file: Cow::Borrowed(file),
+            f,
+            size,
+        })
+    }
+
+    /// [`DiskFile::open`], keeping its own copy of the name (for a reader that outlives
+    /// the caller's).
+    pub fn open_owned(file: &str, path: &Path) -> Result<DiskFile<'static>, ReadError> {
+        let d = DiskFile::open(file, path)?;
+        Ok(DiskFile {
+            file: Cow::Owned(file.to_string()),
+            f: d.f,
+            size: d.size,
+        })
     }
 
     fn io(file: &str, source: std::io::Error) -> ReadError {
@@ -129,7 +144,7 @@ impl<'a> DiskFile<'a> {
         let mut buf = vec![0u8; len as usize];
         self.f
             .read_exact_at(&mut buf, at)
-            .map_err(|e| Self::io(self.file, e))?;
+            .map_err(|e| Self::io(&self.file, e))?;
         Ok(buf)
     }
 
@@ -140,12 +155,12 @@ impl<'a> DiskFile<'a> {
         buf.resize(len as usize, 0);
         self.f
             .read_exact_at(buf, at)
-            .map_err(|e| Self::io(self.file, e))
+            .map_err(|e| Self::io(&self.file, e))
     }
 
     /// A second handle on the file (for readers that take ownership).
     pub fn handle(&self) -> Result<std::fs::File, ReadError> {
-        self.f.try_clone().map_err(|e| Self::io(self.file, e))
+        self.f.try_clone().map_err(|e| Self::io(&self.file, e))
     }
 }
 

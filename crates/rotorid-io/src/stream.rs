@@ -56,6 +56,7 @@ pub fn open_blocks(path: impl AsRef<Path>) -> Result<Option<Box<dyn RowBlocks>>,
     let file = path.display().to_string();
     match Format::from_path(path)? {
         Format::Parquet => Ok(Some(Box::new(crate::parquet::open_blocks(&file, path)?))),
+        Format::Tdms => Ok(Some(Box::new(crate::tdms::open_blocks(&file, path)?))),
         _ => Ok(None),
     }
 }

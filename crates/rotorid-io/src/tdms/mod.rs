@@ -28,6 +28,11 @@
 //! the byte offset; except that a last segment its writer left open (next segment offset
 //! all ones: a recording interrupted mid-segment) is read up to its last whole chunk, and
 //! [`Table::notes`] says how many bytes of the unfinished one were not read.
+//!
+//! [`read_file`] reads the whole file; [`open_blocks`] reads it a block of rows at a time
+//! ([`stream`]: the segments' metadata first, then each channel asked for from where it
+//! stopped, so memory holds a few blocks, never a channel), with the same checks, values
+//! and messages.
 
 use std::collections::HashMap;
 
@@ -39,8 +44,11 @@ use crate::table::{Channel, Table, TimeAxis};
 
 mod daqmx;
 mod scaling;
+pub mod stream;
 
-use scaling::{Props, Value};
+pub use stream::{open_blocks, TdmsBlocks};
+
+use scaling::{Chain, Input, Props, Value};
 
 const TOC_META: u32 = 0x02;
 const TOC_NEW_LIST: u32 = 0x04;
@@ -110,190 +118,317 @@ pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError>
 /// Bytes of raw data decoded at a time (one block of one channel, or of interleaved rows).
 const BLOCK: u64 = 1 << 18;
 
+/// A segment's lead-in, checked against the file's size.
+struct LeadIn {
+    toc: u32,
+    e: Endian,
+    /// The next segment offset as written (all ones: left open by its writer).
+    next: u64,
+    /// End of the lead-in, where the metadata starts.
+    lead_end: u64,
+    /// The raw data offset (the metadata's length).
+    raw: u64,
+    raw_start: u64,
+    seg_end: u64,
+}
+
+/// Reads and checks the lead-in of the segment at `seg` (< the file's size).
+fn lead_in<S: Source + ?Sized>(file: &str, src: &S, seg: u64) -> Result<LeadIn, ReadError> {
+    let size = src.size();
+    // The lead-in, or what the file has of it (the cursor refuses a short one).
+    let head = src.read_at(seg, LEAD_IN.min(size - seg))?;
+    let mut c = Cursor {
+        base: seg,
+        ..Cursor::new(file, &head)
+    };
+    let tag = c.take(4, "TDMS segment tag")?;
+    if tag != b"TDSm" {
+        return Err(c.invalid_at(
+            0,
+            "TDMS segment tag",
+            format!("{tag:?}"),
+            "\"TDSm\" (a .tdms_index file is not read)",
+        ));
+    }
+    let toc = c.u32(Endian::Little, "TDMS table of contents")?;
+    let e = if toc & TOC_BIG_ENDIAN != 0 {
+        Endian::Big
+    } else {
+        Endian::Little
+    };
+    let version = c.u32(e, "TDMS version")?;
+    if version != 4712 && version != 4713 {
+        return Err(c.invalid_at(8, "TDMS version", version, "4712 or 4713"));
+    }
+    let next = c.u64(e, "TDMS next segment offset")?;
+    let raw = c.u64(e, "TDMS raw data offset")?;
+    let lead_end = seg + LEAD_IN;
+    let left = size - lead_end;
+    let seg_len = if next == u64::MAX { left } else { next };
+    if seg_len > left {
+        return Err(ReadError::Truncated {
+            file: file.to_string(),
+            channel: None,
+            offset: seg,
+            what: "TDMS segment".into(),
+            need: seg_len.saturating_add(LEAD_IN),
+            available: left + LEAD_IN,
+        });
+    }
+    if raw > seg_len {
+        return Err(c.invalid_at(
+            20,
+            "TDMS raw data offset",
+            raw,
+            format!("at most the segment's {seg_len} bytes"),
+        ));
+    }
+    // (kTocDAQmxRawData 0x80 is not relied on: the objects' raw data indexes say
+    // whether the data is DAQmx, as some writers leave the flag out)
+    let seg_end = lead_end + seg_len;
+    Ok(LeadIn {
+        toc,
+        e,
+        next,
+        lead_end,
+        raw,
+        raw_start: lead_end + raw,
+        seg_end,
+    })
+}
+
+/// The objects a pass over the segments has met so far, the current object list, and the
+/// notes; what the whole-file reader and the streaming one ([`stream`]) share.
+#[derive(Default)]
+struct Walk {
+    objects: Vec<Object>,
+    by_path: HashMap<String, usize>,
+    /// The object list of the current segment: object, and its raw index there.
+    list: Vec<(usize, Option<RawIndex>)>,
+    notes: Vec<String>,
+}
+
+impl Walk {
+    /// The segment at `seg` (< the file's size): its lead-in and metadata read and checked
+    /// (the objects updated), and the layout of its raw data (checked, not read). Returns
+    /// where the next segment starts.
+    fn segment<'f, S: Source + ?Sized>(
+        &mut self,
+        file: &'f str,
+        src: &S,
+        seg: u64,
+    ) -> Result<(u64, Option<(Raw<'f>, Layout)>), ReadError> {
+        let h = lead_in(file, src, seg)?;
+        if h.toc & TOC_META != 0 {
+            if h.toc & TOC_NEW_LIST != 0 {
+                self.list.clear();
+            }
+            let meta = src.read_at(h.lead_end, h.raw)?;
+            let mut m = Cursor {
+                base: h.lead_end,
+                ..Cursor::new(file, &meta)
+            };
+            metadata(
+                &mut m,
+                h.e,
+                &mut self.objects,
+                &mut self.by_path,
+                &mut self.list,
+            )?;
+        }
+        if h.toc & TOC_RAW == 0 {
+            return Ok((h.seg_end, None));
+        }
+        let raw = Raw {
+            file,
+            start: h.raw_start,
+            end: h.seg_end,
+            size: src.size(),
+            e: h.e,
+            open: h.next == u64::MAX,
+        };
+        let interleaved = h.toc & TOC_INTERLEAVED != 0;
+        let l = layout(
+            &raw,
+            interleaved,
+            &self.objects,
+            &self.list,
+            &mut self.notes,
+        )?;
+        Ok((h.seg_end, l.map(|l| (raw, l))))
+    }
+
+    /// The numeric `group/channel` objects, in the order the file introduced them.
+    fn channels(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.objects.len())
+            .filter(|&k| self.objects[k].path.len() == 2 && self.objects[k].numeric)
+    }
+
+    /// The object of the file (path `/`), whose properties every channel inherits.
+    fn root(&self) -> Option<usize> {
+        self.objects.iter().position(|o| o.path.is_empty())
+    }
+}
+
+/// The error when a file has no channel to read.
+fn no_channels(file: &str) -> ReadError {
+    ReadError::NoChannels {
+        file: file.to_string(),
+        why: "no numeric group/channel object".into(),
+    }
+}
+
 /// Reads the segments of `src`, in memory or on disk; every length is checked against
 /// the bytes the file has left before anything of that length is read.
 fn read_from<S: Source + ?Sized>(file: &str, src: &S) -> Result<Table, ReadError> {
     let size = src.size();
-    let mut objects: Vec<Object> = Vec::new();
-    let mut notes = Vec::new();
-    let mut by_path: HashMap<String, usize> = HashMap::new();
-    // The object list of the current segment: object, and its raw index there.
-    let mut list: Vec<(usize, Option<RawIndex>)> = Vec::new();
+    let mut w = Walk::default();
     let mut seg = 0u64;
     while seg < size {
-        // The lead-in, or what the file has of it (the cursor refuses a short one).
-        let head = src.read_at(seg, LEAD_IN.min(size - seg))?;
-        let mut c = Cursor {
-            base: seg,
-            ..Cursor::new(file, &head)
-        };
-        let tag = c.take(4, "TDMS segment tag")?;
-        if tag != b"TDSm" {
-            return Err(c.invalid_at(
-                0,
-                "TDMS segment tag",
-                format!("{tag:?}"),
-                "\"TDSm\" (a .tdms_index file is not read)",
-            ));
+        let (end, raw) = w.segment(file, src, seg)?;
+        if let Some((raw, l)) = raw {
+            raw_data(src, &raw, l, &mut w.objects)?;
         }
-        let toc = c.u32(Endian::Little, "TDMS table of contents")?;
-        let e = if toc & TOC_BIG_ENDIAN != 0 {
-            Endian::Big
-        } else {
-            Endian::Little
-        };
-        let version = c.u32(e, "TDMS version")?;
-        if version != 4712 && version != 4713 {
-            return Err(c.invalid_at(8, "TDMS version", version, "4712 or 4713"));
-        }
-        let next = c.u64(e, "TDMS next segment offset")?;
-        let raw = c.u64(e, "TDMS raw data offset")?;
-        let lead_end = seg + LEAD_IN;
-        let left = size - lead_end;
-        let seg_len = if next == u64::MAX { left } else { next };
-        if seg_len > left {
-            return Err(ReadError::Truncated {
-                file: file.to_string(),
-                channel: None,
-                offset: seg,
-                what: "TDMS segment".into(),
-                need: seg_len.saturating_add(LEAD_IN),
-                available: left + LEAD_IN,
-            });
-        }
-        if raw > seg_len {
-            return Err(c.invalid_at(
-                20,
-                "TDMS raw data offset",
-                raw,
-                format!("at most the segment's {seg_len} bytes"),
-            ));
-        }
-        // (kTocDAQmxRawData 0x80 is not relied on: the objects' raw data indexes say
-        // whether the data is DAQmx, as some writers leave the flag out)
-        let seg_end = lead_end + seg_len;
-        let raw_start = lead_end + raw;
-        if toc & TOC_META != 0 {
-            if toc & TOC_NEW_LIST != 0 {
-                list.clear();
-            }
-            let meta = src.read_at(lead_end, raw)?;
-            let mut m = Cursor {
-                base: lead_end,
-                ..Cursor::new(file, &meta)
-            };
-            metadata(&mut m, e, &mut objects, &mut by_path, &mut list)?;
-        }
-        if toc & TOC_RAW != 0 {
-            let raw = Raw {
-                file,
-                start: raw_start,
-                end: seg_end,
-                size,
-                e,
-                open: next == u64::MAX,
-            };
-            let interleaved = toc & TOC_INTERLEAVED != 0;
-            raw_data(src, &raw, interleaved, &mut objects, &list, &mut notes)?;
-        }
-        seg = seg_end;
+        seg = end;
     }
     let mut channels = Vec::new();
-    let root = objects.iter().position(|o| o.path.is_empty());
-    for k in 0..objects.len() {
-        if objects[k].path.len() != 2 || !objects[k].numeric {
-            continue;
-        }
-        let mut data = scaled(file, &mut objects, k, root)?;
+    let root = w.root();
+    let numeric: Vec<usize> = w.channels().collect();
+    let objects = &mut w.objects;
+    for k in numeric {
+        let mut data = scaled(file, objects, k, root)?;
         // (room reserved ahead for segments that did not come: Raw::reserve)
         data.shrink_to_fit();
+        let axis = axis(file, &objects[k])?;
         let o = &mut objects[k];
-        let name = o.name();
-        let axis = match o.increment {
-            None => None,
-            Some((inc, _)) if inc > 0.0 && inc.is_finite() => Some(TimeAxis {
-                start: o.start.unwrap_or(0.0),
-                increment: inc,
-            }),
-            Some((inc, at)) => {
-                return Err(ReadError::Invalid {
-                    file: file.to_string(),
-                    channel: Some(name),
-                    offset: at,
-                    what: "TDMS property wf_increment".into(),
-                    found: inc.to_string(),
-                    allowed: "a positive finite number of seconds".into(),
-                })
-            }
-        };
         channels.push(Channel {
-            name,
+            name: o.name(),
             unit: o.unit.take(),
             data,
             axis,
         });
     }
     if channels.is_empty() {
-        return Err(ReadError::NoChannels {
-            file: file.to_string(),
-            why: "no numeric group/channel object".into(),
-        });
+        return Err(no_channels(file));
     }
     Ok(Table {
         file: file.to_string(),
         channels,
-        notes,
+        notes: w.notes,
     })
+}
+
+/// The time axis of channel `o` (`wf_increment`, `wf_start_offset`), checked.
+fn axis(file: &str, o: &Object) -> Result<Option<TimeAxis>, ReadError> {
+    match o.increment {
+        None => Ok(None),
+        Some((inc, _)) if inc > 0.0 && inc.is_finite() => Ok(Some(TimeAxis {
+            start: o.start.unwrap_or(0.0),
+            increment: inc,
+        })),
+        Some((inc, at)) => Err(ReadError::Invalid {
+            file: file.to_string(),
+            channel: Some(o.name()),
+            offset: at,
+            what: "TDMS property wf_increment".into(),
+            found: inc.to_string(),
+            allowed: "a positive finite number of seconds".into(),
+        }),
+    }
+}
+
+/// What the values of channel `objects[k]` are made of: its stored values or one of its
+/// DAQmx scalers' values, and the scales applied to them (those of its properties, or its
+/// group's, or the file's at `root`: [`scaling`]); refused as the reader refuses it.
+fn source(
+    file: &str,
+    objects: &[Object],
+    k: usize,
+    root: Option<usize>,
+) -> Result<(Input, Option<Chain>), ReadError> {
+    let o = &objects[k];
+    let group = &o.path[0];
+    let g = objects
+        .iter()
+        .position(|o| o.path.len() == 1 && &o.path[0] == group);
+    let none = Props::default();
+    let level = |i: Option<usize>| i.map_or(&none, |i| &objects[i].props);
+    let refused = |r: scaling::Refusal| ReadError::Invalid {
+        file: file.to_string(),
+        channel: Some(o.name()),
+        offset: r.offset,
+        what: r.what,
+        found: r.found,
+        allowed: r.allowed,
+    };
+    let has = |input: Input| match input {
+        Input::Stored => !o.daqmx_raw,
+        Input::Scaler(id) => o.scaled_from.iter().any(|(i, _)| *i == id),
+    };
+    match scaling::scaling([&o.props, level(g), level(root)]).map_err(refused)? {
+        Some(s) => {
+            let chain = s.chain();
+            if !has(chain.input) {
+                return Err(refused(chain.missing()));
+            }
+            Ok((chain.input, Some(chain)))
+        }
+        None if !o.daqmx_raw => Ok((Input::Stored, None)),
+        None => match o.scaled_from.as_slice() {
+            [(id, _)] => Ok((Input::Scaler(*id), None)),
+            s => Err(ReadError::Invalid {
+                file: file.to_string(),
+                channel: Some(o.name()),
+                offset: o.daqmx_at,
+                what: "TDMS DAQmx raw data".into(),
+                found: format!(
+                    "{} scalers and no NI_Scale properties saying which to read",
+                    s.len()
+                ),
+                allowed: "one scaler, or NI_Scale properties".into(),
+            }),
+        },
+    }
 }
 
 /// The values of channel `objects[k]`, taken out of it: its stored values, or what the
 /// scaling of its properties (or its group's, or the file's at `root`) makes of them and
-/// of its DAQmx scalers' values ([`scaling`]).
+/// of its DAQmx scalers' values ([`source`]).
 fn scaled(
     file: &str,
     objects: &mut [Object],
     k: usize,
     root: Option<usize>,
 ) -> Result<Vec<f64>, ReadError> {
-    let group = objects[k].path[0].clone();
-    let g = objects
-        .iter()
-        .position(|o| o.path.len() == 1 && o.path[0] == group);
-    let none = Props::default();
-    let level = |i: Option<usize>| i.map_or(&none, |i| &objects[i].props);
-    let name = objects[k].name();
-    let refused = |r: scaling::Refusal| ReadError::Invalid {
-        file: file.to_string(),
-        channel: Some(name.clone()),
-        offset: r.offset,
-        what: r.what,
-        found: r.found,
-        allowed: r.allowed,
-    };
-    let scaling = scaling::scaling([&objects[k].props, level(g), level(root)]).map_err(refused)?;
+    let (input, chain) = source(file, objects, k, root)?;
     let o = &mut objects[k];
-    let raw = (!o.daqmx_raw).then(|| std::mem::take(&mut o.data));
+    let data = std::mem::take(&mut o.data);
     let mut scalers = std::mem::take(&mut o.scaled_from);
-    match scaling {
-        Some(s) => s
-            .apply(raw, &mut |id| {
-                let at = scalers.iter().position(|(i, _)| *i == id)?;
-                Some(scalers.swap_remove(at).1)
-            })
-            .map_err(refused),
-        None => match (raw, scalers.len()) {
-            (Some(data), _) => Ok(data),
-            (None, 1) => Ok(scalers.remove(0).1),
-            (None, n) => Err(ReadError::Invalid {
-                file: file.to_string(),
-                channel: Some(name.clone()),
-                offset: objects[k].daqmx_at,
-                what: "TDMS DAQmx raw data".into(),
-                found: format!("{n} scalers and no NI_Scale properties saying which to read"),
-                allowed: "one scaler, or NI_Scale properties".into(),
-            }),
+    let mut v = match input {
+        Input::Stored => data,
+        Input::Scaler(id) => match scalers.iter().position(|(i, _)| *i == id) {
+            Some(at) => scalers.swap_remove(at).1,
+            // (source found it)
+            None => Vec::new(),
         },
+    };
+    if let Some(c) = chain {
+        c.apply_in_place(&mut v);
     }
+    Ok(v)
+}
+
+/// The values of DAQmx scaler `id` of object `o` read so far (an empty list the first
+/// time: a scaler of a segment with raw data has values, if none).
+fn scaler_values(o: &mut Object, id: u32) -> &mut Vec<f64> {
+    let at = match o.scaled_from.iter().position(|(i, _)| *i == id) {
+        Some(at) => at,
+        None => {
+            o.scaled_from.push((id, Vec::new()));
+            o.scaled_from.len() - 1
+        }
+    };
+    &mut o.scaled_from[at].1
 }
 
 fn string<'a>(c: &mut Cursor<'a>, e: Endian, what: &str) -> Result<&'a str, ReadError> {
@@ -564,40 +699,109 @@ impl Raw<'_> {
     }
 }
 
-/// Reads the raw data `r` of a segment with object list `list` into the objects' data, a
-/// block of at most [`BLOCK`] bytes at a time, in the order (and so with the first error)
-/// of reading each chunk channel after channel.
-fn raw_data<S: Source + ?Sized>(
-    src: &S,
+/// How a segment's raw data is laid out: its objects with data, and its chunks, checked
+/// against the segment (nothing of the data is read to find it).
+enum Layout {
+    /// Channel after channel in each chunk.
+    Plain {
+        present: Vec<(usize, RawIndex)>,
+        chunk: u64,
+        chunks: u64,
+    },
+    /// Value by value in each chunk.
+    Interleaved {
+        present: Vec<(usize, RawIndex)>,
+        chunk: u64,
+        chunks: u64,
+    },
+    /// DAQmx raw buffers ([`daqmx`]).
+    Daqmx(DaqmxLayout),
+}
+
+/// The raw data of a DAQmx segment: each chunk is the raw buffers in turn, buffer `b`
+/// `rows[b]` rows of `widths[b]` bytes.
+struct DaqmxLayout {
+    present: Vec<(usize, RawIndex)>,
+    rows: Vec<u64>,
+    widths: Vec<u32>,
+    /// The scalers of each object of `present`.
+    scalers: Vec<Vec<daqmx::Scaler>>,
+    chunk: u64,
+    chunks: u64,
+}
+
+/// The layout of the raw data `r` of a segment with object list `list`, checked (chunks
+/// that divide it, DAQmx buffers that agree); `None` when there is nothing to read. The
+/// notes gain what an interrupted last segment leaves unread.
+fn layout(
     r: &Raw,
     interleaved: bool,
-    objects: &mut [Object],
+    objects: &[Object],
     list: &[(usize, Option<RawIndex>)],
     notes: &mut Vec<String>,
-) -> Result<(), ReadError> {
+) -> Result<Option<Layout>, ReadError> {
     // errors about the whole raw data name its first byte
-    let c = Cursor {
-        base: r.start,
-        ..Cursor::new(r.file, &[])
-    };
+    let c = raw_cursor(r);
     let present: Vec<(usize, RawIndex)> = list
         .iter()
         .filter_map(|&(k, i)| i.map(|i| (k, i)))
         .filter(|(_, i)| i.bytes > 0 || i.daqmx)
         .collect();
     if present.iter().any(|(_, i)| i.daqmx) {
-        return daqmx_data(src, r, &c, &present, objects, notes);
+        return Ok(daqmx_layout(r, &c, present, objects, notes)?.map(Layout::Daqmx));
     }
     let chunk = present
         .iter()
         .try_fold(0u64, |a, (_, i)| a.checked_add(i.bytes));
     let layout = "chunk its object list describes";
     let Some((chunk, chunks)) = chunk_count(&c, r, chunk, layout, notes)? else {
-        return Ok(());
+        return Ok(None);
     };
-    if interleaved {
-        return interleaved_data(src, r, &c, &present, chunk, chunks, objects);
+    Ok(Some(if interleaved {
+        Layout::Interleaved {
+            present,
+            chunk,
+            chunks,
+        }
+    } else {
+        Layout::Plain {
+            present,
+            chunk,
+            chunks,
+        }
+    }))
+}
+
+/// A cursor on no bytes whose errors name the first byte of the raw data `r`.
+fn raw_cursor<'a>(r: &Raw<'a>) -> Cursor<'a> {
+    Cursor {
+        base: r.start,
+        ..Cursor::new(r.file, &[])
     }
+}
+
+/// Reads the raw data `r` of a segment laid out as `layout` into the objects' data, a
+/// block of at most [`BLOCK`] bytes at a time, in the order (and so with the first error)
+/// of reading each chunk channel after channel.
+fn raw_data<S: Source + ?Sized>(
+    src: &S,
+    r: &Raw,
+    layout: Layout,
+    objects: &mut [Object],
+) -> Result<(), ReadError> {
+    let (present, chunk, chunks) = match layout {
+        Layout::Daqmx(d) => return daqmx_data(src, r, d, objects),
+        Layout::Interleaved {
+            present,
+            chunk,
+            chunks,
+        } => return interleaved_data(src, r, &raw_cursor(r), &present, chunk, chunks, objects),
+        Layout::Plain {
+            present,
+            chunk,
+            chunks,
+        } => (present, chunk, chunks),
+    };
     // Every value of a numeric channel lies in the raw data, so this is at most a value
     // per raw byte.
     for &(k, i) in &present {
@@ -671,17 +875,15 @@ fn chunk_count(
     Ok((chunks > 0).then_some((chunk, chunks)))
 }
 
-/// DAQmx raw data ([`daqmx`]): each chunk is the raw buffers in turn, rows of their width;
-/// each scaler's values are read from its buffer's rows, block by block, onto its channel
-/// (or, for DAQmx raw data, onto the channel's values of that scaler).
-fn daqmx_data<S: Source + ?Sized>(
-    src: &S,
+/// The layout of DAQmx raw data ([`daqmx`]), checked: every object DAQmx, of the same
+/// raw buffers, scalers that do not overlap, chunks that divide the raw data.
+fn daqmx_layout(
     r: &Raw,
     c: &Cursor,
-    present: &[(usize, RawIndex)],
-    objects: &mut [Object],
+    present: Vec<(usize, RawIndex)>,
+    objects: &[Object],
     notes: &mut Vec<String>,
-) -> Result<(), ReadError> {
+) -> Result<Option<DaqmxLayout>, ReadError> {
     if let Some(&(k, _)) = present.iter().find(|(_, i)| !i.daqmx) {
         return Err(c.invalid(
             "TDMS segment objects",
@@ -700,7 +902,7 @@ fn daqmx_data<S: Source + ?Sized>(
     };
     let widths = index(present[0].0).widths.clone();
     let mut rows = vec![0u64; widths.len()];
-    for &(k, i) in present {
+    for &(k, i) in &present {
         let d = index(k);
         if d.widths != widths {
             return Err(c.invalid(
@@ -717,7 +919,7 @@ fn daqmx_data<S: Source + ?Sized>(
     // Scalers of one buffer hold distinct bytes of its rows (as DAQmx lays them out), so
     // the values read are at most one per raw byte.
     let mut used = vec![0u64; widths.len()];
-    for &(k, _) in present {
+    for &(k, _) in &present {
         for s in &index(k).scalers {
             used[s.buffer as usize] += u64::from(s.size);
         }
@@ -741,8 +943,35 @@ fn daqmx_data<S: Source + ?Sized>(
     });
     let layout = "DAQmx chunk its raw buffers describe";
     let Some((chunk, chunks)) = chunk_count(c, r, chunk, layout, notes)? else {
-        return Ok(());
+        return Ok(None);
     };
+    Ok(Some(DaqmxLayout {
+        present,
+        rows,
+        widths,
+        scalers,
+        chunk,
+        chunks,
+    }))
+}
+
+/// DAQmx raw data ([`daqmx`]): each chunk is the raw buffers in turn, rows of their width;
+/// each scaler's values are read from its buffer's rows, block by block, onto its channel
+/// (or, for DAQmx raw data, onto the channel's values of that scaler).
+fn daqmx_data<S: Source + ?Sized>(
+    src: &S,
+    r: &Raw,
+    d: DaqmxLayout,
+    objects: &mut [Object],
+) -> Result<(), ReadError> {
+    let DaqmxLayout {
+        present,
+        rows,
+        widths,
+        scalers,
+        chunk,
+        chunks,
+    } = d;
     let names: Vec<String> = present.iter().map(|&(k, _)| objects[k].name()).collect();
     let mut scratch = Vec::new();
     for n in 0..chunks {
@@ -755,14 +984,7 @@ fn daqmx_data<S: Source + ?Sized>(
                 for s in scalers.iter().filter(|s| s.buffer as usize == b) {
                     let Some(d) = s.dtype else { continue };
                     let out = if o.daqmx_raw {
-                        let at = match o.scaled_from.iter().position(|(id, _)| *id == s.id) {
-                            Some(at) => at,
-                            None => {
-                                o.scaled_from.push((s.id, Vec::new()));
-                                o.scaled_from.len() - 1
-                            }
-                        };
-                        &mut o.scaled_from[at].1
+                        scaler_values(o, s.id)
                     } else {
                         &mut o.data
                     };
@@ -797,9 +1019,7 @@ fn interleaved_data<S: Source + ?Sized>(
 ) -> Result<(), ReadError> {
     let count = present[0].1.count;
     let row: u64 = present.iter().map(|(_, i)| i.size).sum();
-    let bad = present
-        .iter()
-        .position(|(_, i)| i.count != count || i.size == 0);
+    let bad = unequal(present);
     // The columns read: channel, its byte within the row, its type and name.
     let mut cols = Vec::new();
     let mut col = 0;
@@ -852,19 +1072,39 @@ fn interleaved_data<S: Source + ?Sized>(
         }
     }
     if let Some(j) = bad {
-        let (k, i) = present[j];
-        return Err(c.invalid(
-            "TDMS interleaved raw data",
-            format!(
-                "{} with {} values of {} bytes",
-                objects[k].name(),
-                i.count,
-                i.size
-            ),
-            format!("every channel with {count} fixed-size values"),
-        ));
+        return Err(unequal_error(c, present, j, objects));
     }
     Ok(())
+}
+
+/// The first object of interleaved raw data whose values are not of the first one's count
+/// or of a fixed size (interleaved rows need both).
+fn unequal(present: &[(usize, RawIndex)]) -> Option<usize> {
+    let count = present.first()?.1.count;
+    present
+        .iter()
+        .position(|(_, i)| i.count != count || i.size == 0)
+}
+
+/// The error for object `present[j]` of interleaved raw data, found by [`unequal`].
+fn unequal_error(
+    c: &Cursor,
+    present: &[(usize, RawIndex)],
+    j: usize,
+    objects: &[Object],
+) -> ReadError {
+    let count = present[0].1.count;
+    let (k, i) = present[j];
+    c.invalid(
+        "TDMS interleaved raw data",
+        format!(
+            "{} with {} values of {} bytes",
+            objects[k].name(),
+            i.count,
+            i.size
+        ),
+        format!("every channel with {count} fixed-size values"),
+    )
 }
 
 #[cfg(test)]
@@ -929,6 +1169,8 @@ mod tests {
         let mem = read("x.tdms", bytes);
         let disk = read_file("x.tdms", &path);
         assert_eq!(format!("{mem:?}"), format!("{disk:?}"));
+        // and streamed, block by block, alike
+        stream::check::agrees_exactly(bytes, &mem);
         mem
     }
 
@@ -1503,6 +1745,156 @@ mod tests {
             Err(ReadError::Invalid { what, .. }) => assert_eq!(what, "TDMS DAQmx scaler"),
             other => panic!("{other:?}"),
         }
+    }
+
+    /// A segment of table of contents `toc` (as given), byte order `e`, holding `meta`
+    /// and `raw`.
+    fn raw_segment(toc: u32, e: Endian, meta: &[u8], raw: &[u8]) -> Vec<u8> {
+        let u64b = |v: u64| match e {
+            Endian::Little => v.to_le_bytes(),
+            Endian::Big => v.to_be_bytes(),
+        };
+        let mut f = b"TDSm".to_vec();
+        f.extend(toc.to_le_bytes());
+        f.extend(match e {
+            Endian::Little => 4713u32.to_le_bytes(),
+            Endian::Big => 4713u32.to_be_bytes(),
+        });
+        f.extend(u64b((meta.len() + raw.len()) as u64));
+        f.extend(u64b(meta.len() as u64));
+        f.extend(meta);
+        f.extend(raw);
+        f
+    }
+
+    #[test]
+    fn streaming_follows_object_lists_across_segments_of_every_layout() {
+        // Each file is read whole, from memory and disk, and streamed by blocks of 1, 7,
+        // 4096 and all rows (both): the same catalogue, notes and values bit for bit.
+        let f64s = |v: &[f64]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+        let i16s = |v: &[i16]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+        // b is i16 codes scaled by its group's linear scale; a has a unit and a time axis
+        let group = {
+            let path = "/'g'";
+            let mut b = 1u32.to_le_bytes().to_vec();
+            b.extend((path.len() as u32).to_le_bytes());
+            b.extend(path.as_bytes());
+            b.extend(0xFFFF_FFFFu32.to_le_bytes());
+            b.extend(props_bytes(&[
+                ("NI_Number_Of_Scales", 3, 1i32.to_le_bytes().to_vec()),
+                ("NI_Scale[0]_Scale_Type", 0x20, text("Linear")),
+                (
+                    "NI_Scale[0]_Linear_Slope",
+                    10,
+                    0.5f64.to_le_bytes().to_vec(),
+                ),
+                (
+                    "NI_Scale[0]_Linear_Y_Intercept",
+                    10,
+                    (-3.0f64).to_le_bytes().to_vec(),
+                ),
+            ]));
+            b
+        };
+        let a_props = [
+            ("unit_string", 0x20, text("um")),
+            ("wf_increment", 10, 0.001f64.to_le_bytes().to_vec()),
+        ];
+        let mut meta = 2u32.to_le_bytes().to_vec();
+        meta.extend(channel_meta("a", 10, 3, &a_props));
+        meta.extend(channel_meta("b", 2, 2, &[]));
+        // (the group's scale comes in a later segment: the whole file's properties count)
+        let mut f = Vec::new();
+        let seg1_raw = [f64s(&[1.0, 2.0, 3.0]), i16s(&[10, 11])].concat();
+        f.extend(raw_segment(
+            TOC_META | TOC_NEW_LIST | TOC_RAW,
+            Endian::Little,
+            &meta,
+            &seg1_raw,
+        ));
+        // 2: no metadata, the same list, two chunks
+        let seg2_raw = [
+            f64s(&[4.0, 5.0, 6.0]),
+            i16s(&[12, 13]),
+            f64s(&[7.0, 8.0, 9.0]),
+            i16s(&[14, 15]),
+        ]
+        .concat();
+        f.extend(raw_segment(TOC_RAW, Endian::Little, &[], &seg2_raw));
+        // 3: the list updated (not new): a as before (index 0), b without data, and the
+        // group's scale
+        let mut meta3 = 3u32.to_le_bytes().to_vec();
+        for (path, index) in [("/'g'/'a'", 0u32), ("/'g'/'b'", 0xFFFF_FFFF)] {
+            meta3.extend((path.len() as u32).to_le_bytes());
+            meta3.extend(path.as_bytes());
+            meta3.extend(index.to_le_bytes());
+            meta3.extend(0u32.to_le_bytes());
+        }
+        meta3.extend_from_slice(&group[4..]);
+        f.extend(raw_segment(
+            TOC_META | TOC_RAW,
+            Endian::Little,
+            &meta3,
+            &f64s(&[10.0, 11.0, 12.0]),
+        ));
+        // 4: interleaved, a new list: b then a, 2 rows
+        let mut meta4 = 2u32.to_le_bytes().to_vec();
+        meta4.extend(channel_meta("b", 2, 2, &[]));
+        meta4.extend(channel_meta("a", 10, 2, &[]));
+        let mut rows = Vec::new();
+        for (b, a) in [(16i16, 13.0f64), (17, 14.0)] {
+            rows.extend(b.to_le_bytes());
+            rows.extend(a.to_le_bytes());
+        }
+        f.extend(raw_segment(
+            TOC_META | TOC_NEW_LIST | TOC_RAW | TOC_INTERLEAVED,
+            Endian::Little,
+            &meta4,
+            &rows,
+        ));
+        // 5: big endian, a alone, a value 100 000 rows long (blocks of 256 KiB)
+        let n = 100_000u64;
+        let path = "/'g'/'a'";
+        let mut meta5 = 1u32.to_be_bytes().to_vec();
+        meta5.extend((path.len() as u32).to_be_bytes());
+        meta5.extend(path.as_bytes());
+        meta5.extend(20u32.to_be_bytes());
+        meta5.extend(10u32.to_be_bytes());
+        meta5.extend(1u32.to_be_bytes());
+        meta5.extend(n.to_be_bytes());
+        meta5.extend(0u32.to_be_bytes());
+        let big: Vec<u8> = (0..n)
+            .flat_map(|k| (k as f64 * 1.5).to_be_bytes())
+            .collect();
+        f.extend(raw_segment(
+            TOC_META | TOC_NEW_LIST | TOC_RAW | TOC_BIG_ENDIAN,
+            Endian::Big,
+            &meta5,
+            &big,
+        ));
+        let t = both(&f).unwrap();
+        // (the group's scale applies to both)
+        let scale = |v: f64| v * 0.5 - 3.0;
+        let a = &t.channels[0].data;
+        assert_eq!(a.len(), 14 + n as usize);
+        let first: Vec<f64> = (1..=14).map(|v| scale(f64::from(v))).collect();
+        assert_eq!(a[..14], first);
+        assert_eq!(a[14 + 99_999], scale(99_999.0 * 1.5));
+        let b: Vec<f64> = (10..18).map(|c| scale(f64::from(c))).collect();
+        assert_eq!(t.channels[1].data, b);
+        assert_eq!(t.channels[0].unit.as_deref(), Some("um"));
+        // and left open by its writer, cut inside the big-endian segment: its whole rows
+        let open = {
+            let mut g = f.clone();
+            let last = g.len() - big.len() - meta5.len() - 28;
+            g[last + 12..last + 20].copy_from_slice(&u64::MAX.to_be_bytes());
+            g.truncate(g.len() - 8 * 50_000 - 3);
+            g
+        };
+        let t = both(&open).unwrap();
+        // (one chunk of 100 000 values: less than a chunk is left, so no value of it)
+        assert_eq!(t.notes.len(), 1);
+        assert_eq!(t.channels[0].data[..], a[..14]);
     }
 
     /// `f` (one segment) as its writer leaves it when the recording is interrupted: the

@@ -272,64 +272,115 @@ fn level(p: &Props) -> Result<Option<Scaling>, Refusal> {
     }))
 }
 
+/// What a channel's last scale reads, through the chain of its inputs: the stored values
+/// or a DAQmx scaler's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(super) enum Input {
+    /// The stored values.
+    Stored,
+    /// The values of DAQmx scaler `id`.
+    Scaler(u32),
+}
+
+/// A [`Scaling`] resolved: what it reads, and the scales applied to that, in order.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Chain {
+    pub input: Input,
+    /// The scales from the one reading `input` up to the last.
+    order: Vec<usize>,
+    /// The scale that reads `input` (to name it in an error).
+    reader: usize,
+    scales: Vec<Scale>,
+    offset: u64,
+}
+
 impl Scaling {
+    /// The chain from the last scale down to what it reads (inputs come before the
+    /// scales that read them, so it ends).
+    pub(super) fn chain(&self) -> Chain {
+        let mut order = Vec::new();
+        let mut i = self.scales.len() - 1;
+        let input = loop {
+            let source = match &self.scales[i] {
+                Scale::Linear { input, .. }
+                | Scale::Polynomial { input, .. }
+                | Scale::Identity { input } => *input,
+                Scale::Scaler { id } => break Input::Scaler(*id),
+            };
+            order.push(i);
+            if source == RAW {
+                break Input::Stored;
+            }
+            i = source as usize;
+        };
+        order.reverse();
+        Chain {
+            input,
+            order,
+            reader: i,
+            scales: self.scales.clone(),
+            offset: self.offset,
+        }
+    }
+
     /// The channel's values: the last scale applied, through its inputs, to `raw` (the
     /// stored values; `None` for a DAQmx raw channel, which has only its scalers' values)
     /// or to `scaler(id)`. A chain of scales reads one of these once, and each scale
     /// works in place, so memory holds one channel's values.
+    #[cfg(test)]
     pub(super) fn apply(
         &self,
         raw: Option<Vec<f64>>,
         scaler: &mut dyn FnMut(u32) -> Option<Vec<f64>>,
     ) -> Result<Vec<f64>, Refusal> {
-        // The chain from the last scale down to what it reads (inputs come before the
-        // scales that read them, so it ends), then applied from there up.
-        let mut chain = Vec::new();
-        let mut i = self.scales.len() - 1;
-        let mut v = loop {
-            let source = match &self.scales[i] {
-                Scale::Linear { input, .. }
-                | Scale::Polynomial { input, .. }
-                | Scale::Identity { input } => *input,
-                Scale::Scaler { id } => {
-                    break scaler(*id).ok_or_else(|| {
-                        refuse(
-                            self.offset,
-                            format!("TDMS scale {i}"),
-                            format!(
-                                "the values of DAQmx scaler {id}, which the channel does not have"
-                            ),
-                            "a scaler of the channel's DAQmx raw data index",
-                        )
-                    })?;
-                }
-            };
-            chain.push(i);
-            if source == RAW {
-                break raw.ok_or_else(|| {
-                    refuse(
-                        self.offset,
-                        format!("TDMS scale {i}"),
-                        "reading the stored values of a DAQmx raw channel",
-                        "a DAQmx scaler's values (a scale without a type names them)",
-                    )
-                })?;
-            }
-            i = source as usize;
-        };
-        for &i in chain.iter().rev() {
+        let chain = self.chain();
+        let mut v = match chain.input {
+            Input::Scaler(id) => scaler(id),
+            Input::Stored => raw,
+        }
+        .ok_or_else(|| chain.missing())?;
+        chain.apply_in_place(&mut v);
+        Ok(v)
+    }
+}
+
+impl Chain {
+    /// The refusal when the channel has no values of the chain's input (no such DAQmx
+    /// scaler; stored values asked of a DAQmx raw channel).
+    pub(super) fn missing(&self) -> Refusal {
+        let i = self.reader;
+        match self.input {
+            Input::Scaler(id) => refuse(
+                self.offset,
+                format!("TDMS scale {i}"),
+                format!("the values of DAQmx scaler {id}, which the channel does not have"),
+                "a scaler of the channel's DAQmx raw data index",
+            ),
+            Input::Stored => refuse(
+                self.offset,
+                format!("TDMS scale {i}"),
+                "reading the stored values of a DAQmx raw channel",
+                "a DAQmx scaler's values (a scale without a type names them)",
+            ),
+        }
+    }
+
+    /// The scales applied to the input's values `v`, in place, value by value (so a block
+    /// of the values scales as the whole channel does, bit for bit).
+    pub(super) fn apply_in_place(&self, v: &mut [f64]) {
+        for &i in &self.order {
             match &self.scales[i] {
                 Scale::Linear {
                     slope, intercept, ..
                 } => {
-                    for x in &mut v {
+                    for x in v.iter_mut() {
                         *x = *x * slope + intercept;
                     }
                 }
                 Scale::Polynomial { coefficients, .. } => match coefficients.split_last() {
                     None => v.iter_mut().for_each(|x| *x = 0.0),
                     Some((&last, rest)) => {
-                        for x in &mut v {
+                        for x in v.iter_mut() {
                             // numpy's polyval: c[-1] + x * 0, then c[k] + acc * x
                             let mut acc = last + *x * 0.0;
                             for &c in rest.iter().rev() {
@@ -342,7 +393,6 @@ impl Scaling {
                 Scale::Identity { .. } | Scale::Scaler { .. } => {}
             }
         }
-        Ok(v)
     }
 }
 
