@@ -179,28 +179,56 @@ impl crate::stream::RowBlocks for ParquetBlocks {
         };
         let given = self.cursors[first].as_ref().map_or(0, |c| c.given);
         let n = max_rows.min(self.channels[first].len.saturating_sub(given));
+        let file = self.file.as_str();
+        let opened = &self.opened;
+        // each column asked for, with its cursor and output (wanted is distinct)
+        let mut cursors: Vec<Option<&mut Option<ColumnCursor>>> =
+            self.cursors.iter_mut().map(Some).collect();
+        let mut jobs = Vec::with_capacity(wanted.len());
         for (&k, data) in wanted.iter().zip(out.iter_mut()) {
-            let file = self.file.as_str();
-            let opened = &self.opened;
-            let cursor = self.cursors[k].get_or_insert_with(|| ColumnCursor {
-                row_group: 0,
-                reader: None,
-                batch: Batch {
-                    defs: Vec::new(),
-                    row0: 0,
-                    index0: 0,
-                    data_start: 0,
-                },
-                in_chunk: 0,
-                given: 0,
-            });
+            let Some(cursor) = cursors.get_mut(k).and_then(Option::take) else {
+                return Err(err(
+                    file,
+                    None,
+                    format!("column {k} asked for twice or absent"),
+                ));
+            };
+            jobs.push(std::sync::Mutex::new((k, cursor, data)));
+        }
+        // Columns side by side from PARALLEL_FROM bytes a block on, as the whole-file read
+        // decodes them; the first error in column order is the one reported.
+        let bytes = (n as u64).saturating_mul(8 * wanted.len() as u64);
+        let threads = crate::par::threads_for(jobs.len(), bytes, PARALLEL_FROM);
+        let results = crate::par::map_ordered(&jobs, threads, |job| {
+            let mut job = job.lock().unwrap_or_else(|p| p.into_inner());
+            let (k, cursor, data) = &mut *job;
+            let c = &opened.wanted[*k];
+            let cursor = cursor.get_or_insert_with(ColumnCursor::new);
             // A panic of the crate in this column names it (crate::guard).
-            crate::guard::quietly(|| fill(file, opened, &opened.wanted[k], cursor, n, data))
-                .unwrap_or_else(|| {
-                    Err(cursor_undecodable(file, opened, &opened.wanted[k], cursor))
-                })?;
+            crate::guard::quietly(|| fill(file, opened, c, cursor, n, data))
+                .unwrap_or_else(|| Err(cursor_undecodable(file, opened, c, cursor)))
+        });
+        for r in results {
+            r.unwrap_or_else(|| Err(err(file, None, "a column reader failed")))?;
         }
         Ok(n)
+    }
+}
+
+impl ColumnCursor {
+    fn new() -> Self {
+        Self {
+            row_group: 0,
+            reader: None,
+            batch: Batch {
+                defs: Vec::new(),
+                row0: 0,
+                index0: 0,
+                data_start: 0,
+            },
+            in_chunk: 0,
+            given: 0,
+        }
     }
 }
 

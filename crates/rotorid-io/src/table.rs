@@ -129,11 +129,7 @@ impl Table {
 
 /// The index of the item of `items` called `name` (`name_of` gives an item's name), as
 /// [`Table::channel_index`] finds it: an exact match, else the one short-name match.
-pub(crate) fn index_named<T>(
-    items: &[T],
-    name_of: impl Fn(&T) -> &str,
-    name: &str,
-) -> Option<usize> {
+pub fn index_named<T>(items: &[T], name_of: impl Fn(&T) -> &str, name: &str) -> Option<usize> {
     if let Some(i) = items.iter().position(|c| name_of(c) == name) {
         return Some(i);
     }

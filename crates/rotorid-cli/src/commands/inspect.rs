@@ -13,52 +13,113 @@ pub struct InspectArgs {
     pub file: String,
 }
 
-/// Run `rotorid inspect`: one line per channel on stdout.
+/// What `inspect` prints of one channel.
+struct Summary {
+    name: String,
+    samples: usize,
+    unit: Option<String>,
+    /// From the channel's own time axis \[Hz\].
+    axis_rate: Option<f64>,
+    lo: f64,
+    hi: f64,
+    nan: usize,
+    /// The first and last samples (the rate of a time channel).
+    ends: Option<(f64, f64)>,
+}
+
+impl Summary {
+    fn new(name: &str, unit: Option<&str>, axis: Option<rotorid_io::TimeAxis>) -> Self {
+        Self {
+            name: name.to_owned(),
+            samples: 0,
+            unit: unit.map(str::to_owned),
+            axis_rate: axis.map(|a| 1.0 / a.increment),
+            lo: f64::INFINITY,
+            hi: f64::NEG_INFINITY,
+            nan: 0,
+            ends: None,
+        }
+    }
+
+    /// Take the next samples of the channel.
+    fn add(&mut self, data: &[f64]) {
+        let (lo, hi, nan) = extremes(data);
+        self.lo = self.lo.min(lo);
+        self.hi = self.hi.max(hi);
+        self.nan += nan;
+        self.samples += data.len();
+        if let (Some(&first), Some(&last)) = (data.first(), data.last()) {
+            self.ends = Some((self.ends.map_or(first, |e| e.0), last));
+        }
+    }
+}
+
+/// Run `rotorid inspect`: one line per channel on stdout. A TDMS or Parquet file is read a
+/// block of rows at a time (`rotorid_io::stream`), so a recording of any length can be
+/// inspected; the others are read whole.
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
-    let table = tables::read(&args.file)?;
+    let (file, channels) = match rotorid_io::open_blocks(&args.file)? {
+        Some(reader) => streamed(&args.file, reader)?,
+        None => {
+            let table = tables::read(&args.file)?;
+            let channels = table
+                .channels
+                .iter()
+                .map(|c| {
+                    let mut s = Summary::new(&c.name, c.unit.as_deref(), c.axis);
+                    s.add(&c.data);
+                    s
+                })
+                .collect();
+            (table.file, channels)
+        }
+    };
     let mut out = String::new();
     // (writing to a String cannot fail)
     let _ = writeln!(
         out,
         "{}: {} channel{}",
-        table.file,
-        table.channels.len(),
-        if table.channels.len() == 1 { "" } else { "s" }
+        file,
+        channels.len(),
+        if channels.len() == 1 { "" } else { "s" }
     );
     let _ = writeln!(
         out,
         "  {:<28} {:>10} {:<8} {:>14} {:>14} {:>14}",
         "channel", "samples", "unit", "rate [Hz]", "min", "max"
     );
-    // the sample rate: a channel's own time axis, else the time channel t or time
-    let time = ["t", "time"].iter().find_map(|n| table.channel(n));
+    // the sample rate: a channel's own time axis, else the time channel t or time (found
+    // as Table::channel finds it)
+    let time = ["t", "time"]
+        .iter()
+        .find_map(|n| rotorid_io::table::index_named(&channels, |c| &c.name, n))
+        .map(|i| &channels[i]);
     let rate_of_time = time.and_then(|t| {
-        let n = t.data.len();
-        (n >= 2).then(|| (n - 1) as f64 / (t.data[n - 1] - t.data[0]))
+        let (first, last) = t.ends?;
+        (t.samples >= 2).then(|| (t.samples - 1) as f64 / (last - first))
     });
-    for c in &table.channels {
-        let rate = c.axis.map(|a| 1.0 / a.increment).or(rate_of_time);
-        let (lo, hi, nan) = extremes(&c.data);
+    for c in &channels {
+        let rate = c.axis_rate.or(rate_of_time);
         let _ = writeln!(
             out,
             "  {:<28} {:>10} {:<8} {:>14} {:>14} {:>14}{}",
             c.name,
-            c.data.len(),
+            c.samples,
             c.unit.as_deref().unwrap_or("-"),
             rate.filter(|r| r.is_finite())
                 .map_or("-".to_owned(), |r| format!("{r:.6}")),
-            if lo.is_finite() {
-                format!("{lo:.6e}")
+            if c.lo.is_finite() {
+                format!("{:.6e}", c.lo)
             } else {
                 "-".to_owned()
             },
-            if hi.is_finite() {
-                format!("{hi:.6e}")
+            if c.hi.is_finite() {
+                format!("{:.6e}", c.hi)
             } else {
                 "-".to_owned()
             },
-            if nan > 0 {
-                format!("  ({nan} NaN)")
+            if c.nan > 0 {
+                format!("  ({} NaN)", c.nan)
             } else {
                 String::new()
             }
@@ -66,6 +127,51 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
     }
     out!("{out}")?;
     Ok(())
+}
+
+/// Rows a block of `inspect` holds per channel.
+const BLOCK_ROWS: usize = 1 << 16;
+
+/// The summaries of every channel of the file at `path`, read a block of rows at a time
+/// through `reader`: the channels of each length together (a reader gives rows of
+/// channels of one length), one pass over the file per length. The reader's notes go to
+/// stderr as `tables::read` prints them.
+fn streamed(
+    path: &str,
+    reader: Box<dyn rotorid_io::RowBlocks>,
+) -> anyhow::Result<(String, Vec<Summary>)> {
+    for n in reader.notes() {
+        eprintln!("note: {}: {n}", reader.file());
+    }
+    let file = reader.file().to_owned();
+    let infos = reader.channels().to_vec();
+    let mut channels: Vec<Summary> = infos
+        .iter()
+        .map(|c| Summary::new(&c.name, c.unit.as_deref(), c.axis))
+        .collect();
+    let mut lengths: Vec<usize> = infos.iter().map(|c| c.len).collect();
+    lengths.sort_unstable();
+    lengths.dedup();
+    let mut reader = Some(reader);
+    for len in lengths {
+        let wanted: Vec<usize> = (0..infos.len()).filter(|&i| infos[i].len == len).collect();
+        let mut r = match reader.take() {
+            Some(r) => r,
+            None => rotorid_io::open_blocks(path)?
+                .ok_or_else(|| anyhow::anyhow!("{file}: the file no longer streams"))?,
+        };
+        let mut bufs: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::new()).collect();
+        loop {
+            bufs.iter_mut().for_each(Vec::clear);
+            if r.next_rows(&wanted, BLOCK_ROWS, &mut bufs)? == 0 {
+                break;
+            }
+            for (&i, b) in wanted.iter().zip(&bufs) {
+                channels[i].add(b);
+            }
+        }
+    }
+    Ok((file, channels))
 }
 
 /// The least and greatest values of `data` other than NaN (infinities when there are none)

@@ -521,6 +521,89 @@ fn a_parquet_record_is_identified_as_it_is_read() {
 }
 
 #[test]
+fn inspect_of_a_streamed_file_lists_what_the_whole_file_holds() {
+    // TDMS and Parquet files are inspected a block of rows at a time (channels of one
+    // length together): each line's samples, unit, min and max are those of the channel
+    // read whole by rotorid_io, computed here by a plain fold
+    let fixtures = format!("{}/../rotorid-io/fixtures", env!("CARGO_MANIFEST_DIR"));
+    // and a file of several blocks, its extremes and a NaN in different ones
+    let dir = tempfile::tempdir().unwrap();
+    let long = dir.path().join("long.parquet");
+    let n = 200_000;
+    let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-4).collect();
+    let x: Vec<f64> = (0..n)
+        .map(|i| match i {
+            10 => -7.5,
+            150_000 => f64::NAN,
+            199_990 => 9.25,
+            _ => (i as f64 * 0.01).sin(),
+        })
+        .collect();
+    use rotorid_io::write::ParquetColumn::Required;
+    let bytes = rotorid_io::write::parquet_columns_bytes(
+        "long.parquet",
+        &[("t", Required(&t)), ("x", Required(&x))],
+    )
+    .unwrap();
+    std::fs::write(&long, bytes).unwrap();
+    let mut lines_checked = 0;
+    for name in [
+        "ident.parquet",
+        "rec.parquet",
+        "ident.tdms",
+        "rec.tdms",
+        "interleaved.tdms",
+        "long",
+    ] {
+        let path = match name {
+            "long" => long.to_str().unwrap().to_owned(),
+            _ => format!("{fixtures}/{name}"),
+        };
+        let table = rotorid_io::read_table(&path).unwrap();
+        let (listing, _) = run(&["inspect", &path]);
+        let rows: Vec<&str> = listing.lines().skip(2).collect();
+        assert_eq!(rows.len(), table.channels.len(), "{name}: {listing}");
+        for (row, c) in rows.iter().zip(&table.channels) {
+            // the name (it may hold blanks), then samples, unit, rate, min, max
+            let rest = row.trim_start().strip_prefix(c.name.as_str());
+            assert!(rest.is_some(), "{name}: {row} is not {}", c.name);
+            let f: Vec<&str> = std::iter::once(c.name.as_str())
+                .chain(rest.unwrap_or_default().split_whitespace())
+                .collect();
+            let (lo, hi) = c
+                .data
+                .iter()
+                .filter(|v| !v.is_nan())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            let shown = |v: f64| {
+                if v.is_finite() {
+                    format!("{v:.6e}")
+                } else {
+                    "-".to_owned()
+                }
+            };
+            let want = [
+                c.name.clone(),
+                c.data.len().to_string(),
+                c.unit.clone().unwrap_or("-".into()),
+            ];
+            assert_eq!(f[..3], want, "{name}: {row}");
+            assert_eq!(f[4..6], [shown(lo), shown(hi)], "{name}: {row}");
+            let nan = c.data.iter().filter(|v| v.is_nan()).count();
+            assert_eq!(
+                row.contains(&format!("({nan} NaN)")),
+                nan > 0,
+                "{name}: {row}"
+            );
+            lines_checked += 1;
+        }
+    }
+    assert!(lines_checked >= 20, "{lines_checked}");
+}
+
+#[test]
 fn a_panic_of_the_parquet_crate_is_an_error_without_a_panic_message() {
     // Found by fuzzing read_parquet: a BYTE_STREAM_SPLIT page shorter than its value count,
     // on which the parquet crate (59.3.2) indexes out of bounds. rotorid reports an error
