@@ -19,11 +19,12 @@
 //! layer's streaming mode, TDMS segments, UFF58 lines), so memory holds the channels and
 //! one piece (about 1.3x the channels at most); both accept and refuse alike.
 //!
-//! Where the format allows it, a record can also be read a block of rows at a time
-//! ([`open_blocks`]: Parquet now), with the channels for t, x, z, ... picked and converted
-//! to SI a block at a time ([`SiBlocks`]) exactly as [`select()`] picks and converts them:
-//! `rotorid identify` reads such a file on one thread while it identifies on another, in
-//! memory that does not grow with the record ([`stream`]).
+//! Where the format allows it (Parquet row groups and pages, TDMS segments), a record can
+//! also be read a block of rows at a time ([`open_blocks`]), with the channels for t, x, z,
+//! ... picked and converted to SI a block at a time ([`SiBlocks`]) exactly as [`select()`]
+//! picks and converts them: `rotorid identify` reads such a file on one thread while it
+//! identifies on another, and `rotorid inspect` reads it, in memory that does not grow with
+//! the record ([`stream`]).
 //!
 //! [`write_table`] writes a table back as NPZ, MAT level 5 or Parquet ([`mod@write`]).
 //!
