@@ -39,7 +39,8 @@ pub trait RowBlocks: Send {
     /// Appends the next rows of the channels `wanted` (indices into
     /// [`channels`](Self::channels), distinct, all of one length) to `out` (`out[k]` for
     /// `wanted[k]`): the same number of rows to each, at most `max_rows` (>= 1), and
-    /// returns it; 0 once every row was given. `wanted` is the same at every call. An error
+    /// returns it; 0 once every row was given. Each channel's rows go on from where its last
+    /// call left them (so channels of other lengths are read by other calls). An error
     /// names the file, the channel and the byte offset, as the whole-file reader's does.
     fn next_rows(
         &mut self,
@@ -58,6 +59,57 @@ pub fn open_blocks(path: impl AsRef<Path>) -> Result<Option<Box<dyn RowBlocks>>,
         Format::Parquet => Ok(Some(Box::new(crate::parquet::open_blocks(&file, path)?))),
         Format::Tdms => Ok(Some(Box::new(crate::tdms::open_blocks(&file, path)?))),
         _ => Ok(None),
+    }
+}
+
+/// Every row of every channel of `reader`, the channels of each length together (one
+/// call of [`RowBlocks::next_rows`] gives rows of channels of one length), at most
+/// `max_rows` a block: `each(channels, rows)` for each block, `rows[k]` the rows of channel
+/// `channels[k]`. A reader that gives a channel more or fewer rows than its catalogue says
+/// is an error (a file that changed while it was read).
+pub fn for_each_block(
+    reader: &mut dyn RowBlocks,
+    max_rows: usize,
+    mut each: impl FnMut(&[usize], &[Vec<f64>]),
+) -> Result<(), ReadError> {
+    let lens: Vec<usize> = reader.channels().iter().map(|c| c.len).collect();
+    let mut groups = lens.clone();
+    groups.sort_unstable();
+    groups.dedup();
+    for len in groups {
+        let wanted: Vec<usize> = (0..lens.len()).filter(|&k| lens[k] == len).collect();
+        let mut rows: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::new()).collect();
+        let mut total = 0usize;
+        loop {
+            rows.iter_mut().for_each(Vec::clear);
+            let n = reader.next_rows(&wanted, max_rows.max(1), &mut rows)?;
+            debug_assert!(rows.iter().all(|r| r.len() == n), "the same rows to each");
+            total = total.saturating_add(n);
+            if n == 0 || total > len {
+                break;
+            }
+            each(&wanted, &rows);
+        }
+        if total != len {
+            return Err(not_as_catalogued(&*reader, wanted[0], total));
+        }
+    }
+    Ok(())
+}
+
+/// The error for a reader that gave channel `k` `total` rows where its catalogue says
+/// otherwise.
+fn not_as_catalogued(reader: &dyn RowBlocks, k: usize, total: usize) -> ReadError {
+    let c = &reader.channels()[k];
+    ReadError::Container {
+        file: reader.file().to_owned(),
+        channel: Some(c.name.clone()),
+        container: "stream",
+        message: format!(
+            "the file gave {total} rows where its catalogue says {}; did it change while \
+             it was read?",
+            c.len
+        ),
     }
 }
 
@@ -188,8 +240,15 @@ impl SiBlocks {
         let n = self
             .inner
             .next_rows(&self.wanted, max_rows.max(1), &mut raw)?;
-        if n == 0 {
+        if n == 0 && self.done == self.len {
             return Ok(None);
+        }
+        if n == 0 || self.done + n > self.len {
+            return Err(not_as_catalogued(
+                &*self.inner,
+                self.wanted[0],
+                self.done + n,
+            ));
         }
         // each channel's buffer becomes its (first) role's column, converted in place; a
         // channel that plays two roles is copied for the first
@@ -235,7 +294,8 @@ mod tests {
     struct TableBlocks {
         table: Table,
         infos: Vec<ChannelInfo>,
-        done: usize,
+        /// Rows given so far, by channel.
+        done: std::collections::HashMap<usize, usize>,
         step: usize,
     }
 
@@ -254,7 +314,7 @@ mod tests {
             Self {
                 table,
                 infos,
-                done: 0,
+                done: Default::default(),
                 step,
             }
         }
@@ -276,12 +336,20 @@ mod tests {
             max_rows: usize,
             out: &mut [Vec<f64>],
         ) -> Result<usize, ReadError> {
-            let len = self.infos[wanted[0]].len;
-            let n = max_rows.min(self.step).min(len - self.done);
+            // (the rows the channels hold, whatever the catalogue says: a test may make it lie)
+            let done = self.done.get(&wanted[0]).copied().unwrap_or(0);
+            let len = wanted
+                .iter()
+                .map(|&k| self.table.channels[k].data.len())
+                .min()
+                .unwrap_or(0);
+            let n = max_rows.min(self.step).min(len - done);
             for (&k, o) in wanted.iter().zip(out.iter_mut()) {
-                o.extend_from_slice(&self.table.channels[k].data[self.done..self.done + n]);
+                o.extend_from_slice(&self.table.channels[k].data[done..done + n]);
             }
-            self.done += n;
+            for &k in wanted {
+                self.done.insert(k, done + n);
+            }
             Ok(n)
         }
     }
@@ -357,6 +425,49 @@ mod tests {
                     "role {role}, step {step}, blocks of {max_rows}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn every_channel_whole_by_length_and_a_reader_that_breaks_its_catalogue_is_an_error() {
+        let table = Table {
+            file: "rec.tdms".into(),
+            channels: vec![
+                ch("a", None, (0..10).map(f64::from).collect(), None),
+                ch("b", None, (0..4).map(f64::from).collect(), None),
+                ch("c", None, (10..20).map(f64::from).collect(), None),
+            ],
+            notes: Vec::new(),
+        };
+        let mut r = TableBlocks::new(table.clone(), 3);
+        let mut got = vec![Vec::new(); 3];
+        for_each_block(&mut r, 100, |which, rows| {
+            for (&k, part) in which.iter().zip(rows) {
+                assert!(part.len() <= 3);
+                got[k].extend_from_slice(part);
+            }
+        })
+        .unwrap();
+        let want: Vec<Vec<f64>> = table.channels.iter().map(|c| c.data.clone()).collect();
+        assert_eq!(got, want);
+        // a catalogue that says more rows than the file gives, or fewer
+        for len in [12, 8] {
+            let mut r = TableBlocks::new(table.clone(), 3);
+            r.infos[0].len = len;
+            r.infos[2].len = len;
+            let e = for_each_block(&mut r, 100, |_, _| {})
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("catalogue says") && e.contains("\"a\""), "{e}");
+            let mut r = TableBlocks::new(table.clone(), 3);
+            r.infos[1].len = len;
+            r.infos[2].len = len;
+            let mut s = SiBlocks::new(Box::new(r), &ColumnMap::parse("b,c,c").unwrap()).unwrap();
+            let e = std::iter::from_fn(|| s.next_block(5).transpose())
+                .find_map(Result::err)
+                .unwrap()
+                .to_string();
+            assert!(e.contains("catalogue says"), "{e}");
         }
     }
 

@@ -55,33 +55,16 @@ fn files() -> Vec<(String, &'static str, Vec<u8>)> {
     out
 }
 
-/// Every channel of `b`, those of one length read together (a reader gives rows of
-/// channels of one length), `max_rows` rows at a time; checks that each call gives every
-/// channel asked for the same rows, at most `max_rows`, and each channel its length.
+/// Every channel of `b` (`stream::for_each_block`), `max_rows` rows at a time; checks that
+/// each block holds at most `max_rows` rows.
 fn read_all(b: &mut dyn RowBlocks, max_rows: usize) -> Result<Vec<Vec<f64>>, ReadError> {
-    let lens: Vec<usize> = b.channels().iter().map(|c| c.len).collect();
-    let mut data = vec![Vec::new(); lens.len()];
-    let mut groups = lens.clone();
-    groups.sort_unstable();
-    groups.dedup();
-    for len in groups {
-        let wanted: Vec<usize> = (0..lens.len()).filter(|&k| lens[k] == len).collect();
-        let mut out = vec![Vec::new(); wanted.len()];
-        let mut total = 0;
-        loop {
-            let n = b.next_rows(&wanted, max_rows, &mut out)?;
-            assert!(n <= max_rows);
-            total += n;
-            assert!(out.iter().all(|o| o.len() == total));
-            if n == 0 {
-                break;
-            }
+    let mut data = vec![Vec::new(); b.channels().len()];
+    rotorid_io::stream::for_each_block(b, max_rows, |which, rows| {
+        for (&k, r) in which.iter().zip(rows) {
+            assert!(r.len() <= max_rows);
+            data[k].extend_from_slice(r);
         }
-        assert_eq!(total, len);
-        for (k, o) in wanted.into_iter().zip(out) {
-            data[k] = o;
-        }
-    }
+    })?;
     Ok(data)
 }
 

@@ -59,7 +59,7 @@ impl Summary {
 /// inspected; the others are read whole.
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
     let (file, channels) = match rotorid_io::open_blocks(&args.file)? {
-        Some(reader) => streamed(&args.file, reader)?,
+        Some(reader) => streamed(reader)?,
         None => {
             let table = tables::read(&args.file)?;
             let channels = table
@@ -132,46 +132,24 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
 /// Rows a block of `inspect` holds per channel.
 const BLOCK_ROWS: usize = 1 << 16;
 
-/// The summaries of every channel of the file at `path`, read a block of rows at a time
-/// through `reader`: the channels of each length together (a reader gives rows of
-/// channels of one length), one pass over the file per length. The reader's notes go to
-/// stderr as `tables::read` prints them.
-fn streamed(
-    path: &str,
-    reader: Box<dyn rotorid_io::RowBlocks>,
-) -> anyhow::Result<(String, Vec<Summary>)> {
+/// The summaries of every channel of the file `reader` reads a block of rows at a time
+/// (`rotorid_io::stream::for_each_block`: the channels of each length together). The
+/// reader's notes go to stderr as `tables::read` prints them.
+fn streamed(mut reader: Box<dyn rotorid_io::RowBlocks>) -> anyhow::Result<(String, Vec<Summary>)> {
     for n in reader.notes() {
         eprintln!("note: {}: {n}", reader.file());
     }
-    let file = reader.file().to_owned();
-    let infos = reader.channels().to_vec();
-    let mut channels: Vec<Summary> = infos
+    let mut channels: Vec<Summary> = reader
+        .channels()
         .iter()
         .map(|c| Summary::new(&c.name, c.unit.as_deref(), c.axis))
         .collect();
-    let mut lengths: Vec<usize> = infos.iter().map(|c| c.len).collect();
-    lengths.sort_unstable();
-    lengths.dedup();
-    let mut reader = Some(reader);
-    for len in lengths {
-        let wanted: Vec<usize> = (0..infos.len()).filter(|&i| infos[i].len == len).collect();
-        let mut r = match reader.take() {
-            Some(r) => r,
-            None => rotorid_io::open_blocks(path)?
-                .ok_or_else(|| anyhow::anyhow!("{file}: the file no longer streams"))?,
-        };
-        let mut bufs: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::new()).collect();
-        loop {
-            bufs.iter_mut().for_each(Vec::clear);
-            if r.next_rows(&wanted, BLOCK_ROWS, &mut bufs)? == 0 {
-                break;
-            }
-            for (&i, b) in wanted.iter().zip(&bufs) {
-                channels[i].add(b);
-            }
+    rotorid_io::stream::for_each_block(&mut *reader, BLOCK_ROWS, |which, rows| {
+        for (&i, r) in which.iter().zip(rows) {
+            channels[i].add(r);
         }
-    }
-    Ok((file, channels))
+    })?;
+    Ok((reader.file().to_owned(), channels))
 }
 
 /// The least and greatest values of `data` other than NaN (infinities when there are none)

@@ -461,39 +461,20 @@ pub(super) mod check {
     /// Block sizes streamed: one row, a few, many, all.
     pub(crate) const MAX_ROWS: [usize; 4] = [1, 7, 4096, usize::MAX];
 
-    /// The channels of `b` (all of them, those of one length read together, as
-    /// [`RowBlocks::next_rows`] asks), `max_rows` rows at a time.
+    /// The channels of `b` (all of them: [`crate::stream::for_each_block`]), `max_rows`
+    /// rows at a time; once done, a further call gives nothing.
     pub(crate) fn read_all(
         b: &mut TdmsBlocks,
         max_rows: usize,
     ) -> Result<Vec<Vec<f64>>, ReadError> {
+        let mut data = vec![Vec::new(); b.channels().len()];
+        crate::stream::for_each_block(b, max_rows, |which, rows| {
+            for (&k, r) in which.iter().zip(rows) {
+                assert!(r.len() <= max_rows);
+                data[k].extend_from_slice(r);
+            }
+        })?;
         let lens: Vec<usize> = b.channels().iter().map(|c| c.len).collect();
-        let mut data = vec![Vec::new(); lens.len()];
-        let mut groups: Vec<usize> = lens.clone();
-        groups.sort_unstable();
-        groups.dedup();
-        for len in groups {
-            let wanted: Vec<usize> = (0..lens.len()).filter(|&k| lens[k] == len).collect();
-            let mut out = vec![Vec::new(); wanted.len()];
-            let mut total = 0;
-            loop {
-                let before: Vec<usize> = out.iter().map(Vec::len).collect();
-                let n = b.next_rows(&wanted, max_rows, &mut out)?;
-                for (o, was) in out.iter().zip(before) {
-                    assert_eq!(o.len(), was + n, "every channel gains the same rows");
-                }
-                assert!(n <= max_rows);
-                if n == 0 {
-                    break;
-                }
-                total += n;
-            }
-            assert_eq!(total, len, "the catalogue's length is what is read");
-            for (k, o) in wanted.into_iter().zip(out) {
-                data[k] = o;
-            }
-        }
-        // once done, nothing more
         let all: Vec<usize> = (0..lens.len()).collect();
         let mut out = vec![Vec::new(); lens.len()];
         if lens.iter().all(|&l| l == lens[0]) {
@@ -502,7 +483,7 @@ pub(super) mod check {
         Ok(data)
     }
 
-    fn bits(v: &[f64]) -> Vec<u64> {
+    pub(crate) fn bits(v: &[f64]) -> Vec<u64> {
         v.iter().map(|x| x.to_bits()).collect()
     }
 
@@ -552,26 +533,32 @@ pub(super) mod check {
 
 #[cfg(test)]
 mod tests {
-    use super::check::{agrees, read_all};
+    use super::check::{agrees, bits, read_all};
     use super::*;
+    use crate::stream::RowBlocks;
 
-    /// A segment of a new object list: channels `(name, values)` of f64, contiguous.
-    fn segment(channels: &[(&str, &[f64])]) -> Vec<u8> {
+    /// A TDMS segment of a new object list holding channels `(path, type code, values)` of
+    /// little-endian `f64` (type 10) or `i16` (type 2) contiguous raw data.
+    fn segment(channels: &[(&str, u32, &[f64])]) -> Vec<u8> {
         let mut meta = (channels.len() as u32).to_le_bytes().to_vec();
         let mut raw = Vec::new();
-        for (name, values) in channels {
-            let path = format!("/'g'/'{name}'");
+        for &(path, t, values) in channels {
             meta.extend((path.len() as u32).to_le_bytes());
             meta.extend(path.as_bytes());
             meta.extend(20u32.to_le_bytes());
-            meta.extend(10u32.to_le_bytes());
+            meta.extend(t.to_le_bytes());
             meta.extend(1u32.to_le_bytes());
             meta.extend((values.len() as u64).to_le_bytes());
             meta.extend(0u32.to_le_bytes());
-            raw.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+            for &v in values {
+                match t {
+                    10 => raw.extend(v.to_le_bytes()),
+                    _ => raw.extend((v as i16).to_le_bytes()),
+                }
+            }
         }
         let mut f = b"TDSm".to_vec();
-        f.extend(0x0Eu32.to_le_bytes());
+        f.extend((0x02u32 | 0x04 | 0x08).to_le_bytes());
         f.extend(4713u32.to_le_bytes());
         f.extend(((meta.len() + raw.len()) as u64).to_le_bytes());
         f.extend((meta.len() as u64).to_le_bytes());
@@ -598,7 +585,7 @@ mod tests {
             .chain(std::iter::repeat_n(5, 30))
         {
             let (a, b) = (next(n), next(n));
-            f.extend(segment(&[("a", &a), ("b", &b)]));
+            f.extend(segment(&[("/'g'/'a'", 10, &a), ("/'g'/'b'", 10, &b)]));
         }
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("x.tdms");
@@ -610,5 +597,50 @@ mod tests {
         }
         assert_eq!(read_all(&mut b, 4).unwrap()[0].len(), 303);
         assert_eq!(agrees(&path, &super::super::read_file("x.tdms", &path)), 0);
+    }
+
+    #[test]
+    fn a_long_file_of_many_segments_streams_in_bounded_memory() {
+        // 40 segments of 60,000 f64 values of x and 60,000 i16 of z (2.4 million values each,
+        // 38.4 MB as f64), 4096 rows at a time: the queues hold, per channel, fewer than
+        // 4096 rows plus one 256 KiB block of the file (32,768 f64 or 131,072 i16), twice
+        // over for a vector's growth, at 8 bytes a value
+        let per = 60_000;
+        let mut f = Vec::new();
+        let (mut xs, mut zs) = (Vec::new(), Vec::new());
+        for s in 0..40 {
+            let x: Vec<f64> = (0..per).map(|i| (s * per + i) as f64 * 0.25).collect();
+            let z: Vec<f64> = (0..per).map(|i| ((s * 7 + i) % 30_000) as f64).collect();
+            f.extend(segment(&[("/'g'/'x'", 10, &x), ("/'g'/'z'", 2, &z)]));
+            xs.extend(x);
+            zs.extend(z);
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("long.tdms");
+        std::fs::write(&path, &f).unwrap();
+        let max_rows = 4096;
+        let mut b = open_blocks("long.tdms", &path).unwrap();
+        assert_eq!(b.channels()[0].len, 40 * per);
+        let mut got = [Vec::new(), Vec::new()];
+        let mut out = [Vec::new(), Vec::new()];
+        loop {
+            let n = b.next_rows(&[0, 1], max_rows, &mut out).unwrap();
+            if n == 0 {
+                break;
+            }
+            for (g, o) in got.iter_mut().zip(&mut out) {
+                g.append(o);
+            }
+        }
+        assert_eq!(bits(&got[0]), bits(&xs));
+        assert_eq!(bits(&got[1]), bits(&zs));
+        let bound = 2 * (2 * (max_rows + (1 << 18) / 8) + 2 * (max_rows + (1 << 18) / 2)) * 8;
+        let peak = b.peak_queued_bytes();
+        eprintln!(
+            "queues held at most {peak} bytes (bound {bound}; the channels: {})",
+            2 * 8 * xs.len()
+        );
+        assert!(peak > 0 && peak <= bound, "{peak} > {bound}");
+        assert!(peak * 4 < 2 * 8 * xs.len());
     }
 }
