@@ -28,16 +28,18 @@ use crate::stream::{self, Stream};
 /// `OSError` (its subclass by kind) for files, `ValueError` for everything else.
 fn py_err(e: Error) -> PyErr {
     let text = e.to_string();
+    let by_kind = |kind: std::io::ErrorKind| match kind {
+        std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(text.clone()),
+        std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(text.clone()),
+        _ => PyOSError::new_err(text.clone()),
+    };
     match e {
-        Error::Io { source, .. } => match source.kind() {
-            std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(text),
-            std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(text),
-            _ => PyOSError::new_err(text),
-        },
+        Error::Io { source, .. } => by_kind(source.kind()),
         Error::Csv(c) if c.io_kind.is_some() => PyOSError::new_err(text),
-        Error::Read(r) if matches!(*r, rotorid_io::ReadError::Io { .. }) => {
-            PyOSError::new_err(text)
-        }
+        Error::Read(r) => match *r {
+            rotorid_io::ReadError::Io { source, .. } => by_kind(source.kind()),
+            _ => PyValueError::new_err(text),
+        },
         _ => PyValueError::new_err(text),
     }
 }
@@ -356,8 +358,14 @@ fn read(
     for (name, unit) in r.converted {
         units.set_item(name, unit)?;
     }
-    // what the reader noted (an interrupted recording's unfinished chunk) as a warning
-    for n in &r.notes {
+    warn_notes(py, &path, &r.notes)?;
+    Ok((d, units))
+}
+
+/// What the reader noted about the file at `path` (an interrupted recording's unfinished
+/// chunk), each as a `UserWarning`.
+fn warn_notes(py: Python<'_>, path: &str, notes: &[String]) -> PyResult<()> {
+    for n in notes {
         let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
         PyErr::warn(
             py,
@@ -366,7 +374,77 @@ fn read(
             1,
         )?;
     }
-    Ok((d, units))
+    Ok(())
+}
+
+/// The record at `path` read `rows` rows at a time (`rotorid.read_blocks`): an iterator of
+/// `(first row, {t, x, z[, phi, phi_dot, phi_ddot]: float64 array})`, in SI, bit for bit
+/// the numbers of `read`; `units` as `read`'s second value. TDMS and Parquet are streamed
+/// (memory holds a block, whatever the record's length); the other formats are read whole,
+/// then handed out. The GIL is released while a block is read.
+#[pyfunction]
+#[pyo3(signature = (path, columns=None, rows=65536))]
+fn read_blocks(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    columns: Option<String>,
+    rows: usize,
+) -> PyResult<PyBlocks> {
+    let path = path.to_string_lossy().into_owned();
+    let r = py
+        .detach(|| crate::response::open_blocks(&path, columns.as_deref(), rows))
+        .map_err(py_err)?;
+    warn_notes(py, &path, &r.notes)?;
+    Ok(PyBlocks {
+        units: r.converted.clone(),
+        inner: Mutex::new(r),
+    })
+}
+
+/// The iterator [`read_blocks`] returns.
+#[pyclass(module = "rotorid._rotorid", name = "Blocks")]
+pub struct PyBlocks {
+    inner: Mutex<crate::response::BlockReader>,
+    units: Vec<(String, String)>,
+}
+
+#[pymethods]
+impl PyBlocks {
+    /// Each role whose channel the file gives in another unit than SI, with that unit.
+    #[getter]
+    fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let units = PyDict::new(py);
+        for (name, unit) in &self.units {
+            units.set_item(name, unit)?;
+        }
+        Ok(units)
+    }
+
+    fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __next__<'py>(&self, py: Python<'py>) -> PyResult<Option<(usize, Bound<'py, PyDict>)>> {
+        let next = py
+            .detach(|| {
+                let mut r = self.inner.lock().unwrap_or_else(|p| p.into_inner());
+                r.next_block()
+            })
+            .map_err(py_err)?;
+        let Some(b) = next else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("t", PyArray1::from_vec(py, b.t))?;
+        d.set_item("x", PyArray1::from_vec(py, b.x))?;
+        d.set_item("z", PyArray1::from_vec(py, b.z))?;
+        if let Some(speed) = b.speed {
+            for (name, c) in SPEED_NAMES.iter().zip(speed) {
+                d.set_item(name, PyArray1::from_vec(py, c))?;
+            }
+        }
+        Ok(Some((b.first, d)))
+    }
 }
 
 /// The options of a call.
@@ -544,6 +622,8 @@ fn rotorid_extension(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySession>()?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(read_blocks, m)?)?;
+    m.add_class::<PyBlocks>()?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;
     m.add("METHODS", options::METHOD_NAMES.to_vec())?;
     m.add("UNKNOWNS", options::UNKNOWN_NAMES.to_vec())?;

@@ -58,17 +58,102 @@ pub fn read_any(path: &str, columns: Option<&str>) -> Result<Response, Error> {
     let s = rotorid_io::select(table, &map)?;
     Ok(Response {
         notes,
-        converted: s
-            .used
-            .iter()
-            .filter(|u| !u.conversion.is_identity())
-            .map(|u| (u.role.to_owned(), u.conversion.unit.to_owned()))
-            .collect(),
+        converted: converted_of(&s.used),
         t: s.t,
         x: s.x,
         z: s.z,
         speed: s.speed,
     })
+}
+
+/// A record read a block of rows at a time, in SI: a TDMS or Parquet file streamed
+/// (`rotorid_io::stream`: memory holds a block, whatever the record's length); any other
+/// format read whole as [`read_any`] reads it, then handed out a block at a time. The
+/// samples are [`read_any`]'s, bit for bit.
+pub struct BlockReader {
+    source: BlockSource,
+    /// Rows a block holds at most.
+    rows: usize,
+    /// As [`Response::converted`].
+    pub converted: Vec<(String, String)>,
+    /// As [`Response::notes`].
+    pub notes: Vec<String>,
+}
+
+enum BlockSource {
+    Streamed(rotorid_io::SiBlocks),
+    Whole { r: Response, next: usize },
+}
+
+/// Open the record at `path` to read it `rows` rows (>= 1) at a time; `columns` as in
+/// [`read_any`].
+pub fn open_blocks(path: &str, columns: Option<&str>, rows: usize) -> Result<BlockReader, Error> {
+    if rows == 0 {
+        return Err(Error::invalid(
+            "rows = 0 is out of range: a block holds at least one row (an integer >= 1)",
+        ));
+    }
+    let format = rotorid_io::Format::from_path(std::path::Path::new(path)).ok();
+    let streamed = match format {
+        Some(rotorid_io::Format::Csv) | None => None,
+        Some(_) => rotorid_io::open_blocks(path)?,
+    };
+    let Some(reader) = streamed else {
+        let r = read_any(path, columns)?;
+        return Ok(BlockReader {
+            rows,
+            converted: r.converted.clone(),
+            notes: r.notes.clone(),
+            source: BlockSource::Whole { r, next: 0 },
+        });
+    };
+    let notes = reader.notes().to_vec();
+    let map = match columns {
+        Some(spec) => rotorid_io::ColumnMap::parse(spec)?,
+        None => rotorid_io::ColumnMap::default(),
+    };
+    let blocks = rotorid_io::SiBlocks::new(reader, &map)?;
+    Ok(BlockReader {
+        rows,
+        converted: converted_of(blocks.used()),
+        notes,
+        source: BlockSource::Streamed(blocks),
+    })
+}
+
+/// The roles whose channel was converted to SI, each with the unit the file gave.
+fn converted_of(used: &[rotorid_io::select::Used]) -> Vec<(String, String)> {
+    used.iter()
+        .filter(|u| !u.conversion.is_identity())
+        .map(|u| (u.role.to_owned(), u.conversion.unit.to_owned()))
+        .collect()
+}
+
+impl BlockReader {
+    /// The next block, `None` after the last.
+    pub fn next_block(&mut self) -> Result<Option<rotorid_io::SiBlock>, Error> {
+        match &mut self.source {
+            BlockSource::Streamed(b) => Ok(b.next_block(self.rows)?),
+            BlockSource::Whole { r, next } => {
+                let first = *next;
+                let end = first.saturating_add(self.rows).min(r.x.len());
+                if first >= end {
+                    return Ok(None);
+                }
+                *next = end;
+                Ok(Some(rotorid_io::SiBlock {
+                    first,
+                    t: r.t[first..end].to_vec(),
+                    x: r.x[first..end].to_vec(),
+                    z: r.z[first..end].to_vec(),
+                    speed: r
+                        .speed
+                        .as_ref()
+                        .map(|s| s.each_ref().map(|c| c[first..end].to_vec())),
+                }))
+            }
+        }
+    }
 }
 
 /// Read a response CSV from `input`; `file` names it in messages.

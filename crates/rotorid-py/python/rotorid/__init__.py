@@ -23,7 +23,7 @@ same result (``res.to_dict()``) as ``rotorid identify --summary`` on the same fi
 from __future__ import annotations
 
 import os
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterator, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -41,6 +41,7 @@ __all__ = [
     "Session",
     "identify",
     "read",
+    "read_blocks",
     "simulate",
 ]
 
@@ -134,6 +135,47 @@ def read(path: str | os.PathLike[str], columns: str | None = None) -> pd.DataFra
     df = _frame(columns)
     df.attrs["units"] = dict(units)
     return df
+
+
+def read_blocks(
+    path: str | os.PathLike[str], columns: str | None = None, rows: int = 65536
+) -> Iterator[pd.DataFrame]:
+    """Read a record as :func:`read` does, ``rows`` rows at a time: for a recording too
+    long to hold, fed block by block to a :class:`Session`.
+
+    A LabVIEW .tdms or a .parquet file is streamed (TDMS segments, Parquet row groups and
+    pages): memory holds a block, whatever the recording's length. Any other format is read
+    whole, as :func:`read` reads it, then handed out a block at a time.
+
+    The file is opened, and its channels checked, when this is called (an error is raised
+    here, not at the first block); a fault found later in the file is raised by the block
+    that reaches it, after every block before it.
+
+    Returns:
+        An iterator of DataFrames of at most ``rows`` rows: the columns of :func:`read`
+        (t [s], x, z [m], and phi [rad], phi_dot [rad/s], phi_ddot [rad/s^2] when the file
+        has them), bit for bit its numbers, indexed by sample number (the first block's
+        index starts at 0), ``attrs["units"]`` as :func:`read` gives it.
+
+    Warns:
+        UserWarning: as :func:`read` (a TDMS recording interrupted mid-segment).
+
+    Raises:
+        ValueError: as :func:`read`, and ``rows`` < 1. OSError: the file cannot be read.
+    """
+    if isinstance(rows, bool) or not isinstance(rows, int) or rows < 1:
+        raise ValueError(f"rows = {rows!r} is out of range: an integer >= 1 (rows per block)")
+    blocks = _rotorid.read_blocks(os.fspath(path), columns, rows)
+    units = dict(blocks.units)
+
+    def frames() -> Iterator[pd.DataFrame]:
+        for first, cols in blocks:
+            df = _frame(cols)
+            df.index = pd.RangeIndex(first, first + len(df))
+            df.attrs["units"] = dict(units)
+            yield df
+
+    return frames()
 
 
 def _columns(data: Any) -> dict[str, Any]:

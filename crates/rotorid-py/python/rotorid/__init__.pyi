@@ -1,7 +1,7 @@
 """Type stubs of rotorid (SI units throughout; see the docstrings)."""
 
 import os
-from typing import Any, Mapping, Sequence, final
+from typing import Any, Iterator, Mapping, Sequence, final
 
 import numpy as np
 import pandas as pd
@@ -17,6 +17,7 @@ __all__ = [
     "Session",
     "identify",
     "read",
+    "read_blocks",
     "simulate",
 ]
 
@@ -88,6 +89,11 @@ def simulate(
 
 def read(path: str | os.PathLike[str], columns: str | None = None) -> pd.DataFrame:
     """A response CSV as the CLI reads it."""
+
+def read_blocks(
+    path: str | os.PathLike[str], columns: str | None = None, rows: int = 65536
+) -> Iterator[pd.DataFrame]:
+    """The record :func:`read` reads, ``rows`` rows at a time (TDMS and Parquet streamed)."""
 
 def identify(
     data: pd.DataFrame | Mapping[str, Any],

@@ -6,7 +6,7 @@ import numpy as np
 
 from . import Scenario as Scenario
 
-__all__ = ["ESTIMATE_COLUMNS", "METHODS", "UNKNOWNS", "Scenario", "Session", "identify", "read", "simulate"]
+__all__ = ["ESTIMATE_COLUMNS", "METHODS", "UNKNOWNS", "Blocks", "Scenario", "Session", "identify", "read", "read_blocks", "simulate"]
 
 METHODS: list[str]
 UNKNOWNS: list[str]
@@ -26,6 +26,13 @@ def simulate(
     vz0: float | None = None,
 ) -> dict[str, np.ndarray]: ...
 def read(path: str, columns: str | None = None) -> tuple[dict[str, np.ndarray], dict[str, str]]: ...
+def read_blocks(path: str, columns: str | None = None, rows: int = 65536) -> Blocks: ...
+@final
+class Blocks:
+    @property
+    def units(self) -> dict[str, str]: ...
+    def __iter__(self) -> Blocks: ...
+    def __next__(self) -> tuple[int, dict[str, np.ndarray]]: ...
 def identify(
     scenario: Scenario,
     method: str,
