@@ -70,14 +70,33 @@ pub fn open_blocks(path: impl AsRef<Path>) -> Result<Option<Box<dyn RowBlocks>>,
 pub fn for_each_block(
     reader: &mut dyn RowBlocks,
     max_rows: usize,
+    each: impl FnMut(&[usize], &[Vec<f64>]),
+) -> Result<(), ReadError> {
+    let all: Vec<usize> = (0..reader.channels().len()).collect();
+    for_each_block_of(reader, &all, max_rows, each)
+}
+
+/// [`for_each_block`] over the channels `channels` of `reader` only (indices into its
+/// catalogue, distinct, each not yet read).
+pub fn for_each_block_of(
+    reader: &mut dyn RowBlocks,
+    channels: &[usize],
+    max_rows: usize,
     mut each: impl FnMut(&[usize], &[Vec<f64>]),
 ) -> Result<(), ReadError> {
     let lens: Vec<usize> = reader.channels().iter().map(|c| c.len).collect();
-    let mut groups = lens.clone();
+    let mut groups: Vec<usize> = channels
+        .iter()
+        .filter_map(|&k| lens.get(k).copied())
+        .collect();
     groups.sort_unstable();
     groups.dedup();
     for len in groups {
-        let wanted: Vec<usize> = (0..lens.len()).filter(|&k| lens[k] == len).collect();
+        let wanted: Vec<usize> = channels
+            .iter()
+            .copied()
+            .filter(|&k| lens.get(k) == Some(&len))
+            .collect();
         let mut rows: Vec<Vec<f64>> = wanted.iter().map(|_| Vec::new()).collect();
         let mut total = 0usize;
         loop {
@@ -449,6 +468,19 @@ mod tests {
         })
         .unwrap();
         let want: Vec<Vec<f64>> = table.channels.iter().map(|c| c.data.clone()).collect();
+        assert_eq!(got, want);
+        // one channel alone, then the others: each from its start, whole
+        let mut r = TableBlocks::new(table.clone(), 3);
+        let mut got = vec![Vec::new(); 3];
+        for only in [[2].as_slice(), &[0, 1]] {
+            for_each_block_of(&mut r, only, 4, |which, rows| {
+                for (&k, part) in which.iter().zip(rows) {
+                    assert!(only.contains(&k));
+                    got[k].extend_from_slice(part);
+                }
+            })
+            .unwrap();
+        }
         assert_eq!(got, want);
         // a catalogue that says more rows than the file gives, or fewer
         for len in [12, 8] {

@@ -59,7 +59,7 @@ impl Summary {
 /// inspected; the others are read whole.
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
     let (file, channels) = match rotorid_io::open_blocks(&args.file)? {
-        Some(reader) => streamed(reader)?,
+        Some(reader) => streamed(&args.file, reader)?,
         None => {
             let table = tables::read(&args.file)?;
             let channels = table
@@ -129,27 +129,65 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Rows a block of `inspect` holds per channel.
+/// Rows a block of `inspect` holds per channel (512 KiB of `f64`).
 const BLOCK_ROWS: usize = 1 << 16;
 
-/// The summaries of every channel of the file `reader` reads a block of rows at a time
-/// (`rotorid_io::stream::for_each_block`: the channels of each length together). The
-/// reader's notes go to stderr as `tables::read` prints them.
-fn streamed(mut reader: Box<dyn rotorid_io::RowBlocks>) -> anyhow::Result<(String, Vec<Summary>)> {
+/// The summaries of every channel of the file at `path`, which `reader` reads a block of
+/// rows at a time (`rotorid_io::stream`). The channels are summed up side by side, as the
+/// whole read decodes them: each thread (at most two) takes the next channel not yet taken
+/// and reads it to its end through a reader of its own (the first thread through `reader`),
+/// so no thread waits for another at every block. Of several channels that cannot be read,
+/// the first in file order is the one reported. The reader's notes go to stderr as
+/// `tables::read` prints them.
+fn streamed(
+    path: &str,
+    reader: Box<dyn rotorid_io::RowBlocks>,
+) -> anyhow::Result<(String, Vec<Summary>)> {
     for n in reader.notes() {
         eprintln!("note: {}: {n}", reader.file());
     }
-    let mut channels: Vec<Summary> = reader
-        .channels()
-        .iter()
-        .map(|c| Summary::new(&c.name, c.unit.as_deref(), c.axis))
-        .collect();
-    rotorid_io::stream::for_each_block(&mut *reader, BLOCK_ROWS, |which, rows| {
-        for (&i, r) in which.iter().zip(rows) {
-            channels[i].add(r);
+    let file = reader.file().to_owned();
+    let infos = reader.channels().to_vec();
+    let threads = std::thread::available_parallelism()
+        .map_or(1, std::num::NonZeroUsize::get)
+        .clamp(1, 2)
+        .min(infos.len().max(1));
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: Vec<std::sync::Mutex<Option<anyhow::Result<Summary>>>> =
+        infos.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    let work = |mut r: Box<dyn rotorid_io::RowBlocks>| loop {
+        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let Some(info) = infos.get(k) else {
+            return;
+        };
+        let mut s = Summary::new(&info.name, info.unit.as_deref(), info.axis);
+        let read = rotorid_io::stream::for_each_block_of(&mut *r, &[k], BLOCK_ROWS, |_, rows| {
+            s.add(&rows[0])
+        });
+        *results[k].lock().unwrap_or_else(|p| p.into_inner()) =
+            Some(read.map(|()| s).map_err(Into::into));
+    };
+    std::thread::scope(|scope| -> anyhow::Result<()> {
+        let mut readers = vec![reader];
+        for _ in 1..threads {
+            // (a format that streams opens again; should it not, one thread does it all)
+            if let Some(r) = rotorid_io::open_blocks(path)? {
+                readers.push(r);
+            }
         }
+        for r in readers {
+            scope.spawn(|| work(r));
+        }
+        Ok(())
     })?;
-    Ok((reader.file().to_owned(), channels))
+    let mut channels = Vec::with_capacity(infos.len());
+    for (r, info) in results.into_iter().zip(&infos) {
+        let r = r.into_inner().unwrap_or_else(|p| p.into_inner());
+        channels.push(
+            r.ok_or_else(|| anyhow::anyhow!("{file}: channel {:?} was not read", info.name))??,
+        );
+    }
+    Ok((file, channels))
 }
 
 /// The least and greatest values of `data` other than NaN (infinities when there are none)

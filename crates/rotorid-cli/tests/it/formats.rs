@@ -604,6 +604,42 @@ fn inspect_of_a_streamed_file_lists_what_the_whole_file_holds() {
 }
 
 #[test]
+fn inspect_names_the_first_bad_channel_in_file_order_whichever_thread_reads_it() {
+    // inspect reads a streamed file's channels on two threads, each taking the next: of b
+    // (a null late) and d (a null early), b is named, as a read one by one would name it
+    use rotorid_io::write::ParquetColumn::{Optional, Required};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("two_bad.parquet");
+    let ok: Vec<f64> = (0..100_000).map(f64::from).collect();
+    let hole = |at: usize| -> Vec<Option<f64>> {
+        (0..100_000)
+            .map(|i| (i != at).then_some(i as f64))
+            .collect()
+    };
+    let (b, d) = (hole(99_000), hole(1));
+    let cols = [
+        ("a", Required(&ok)),
+        ("b", Optional(&b)),
+        ("c", Required(&ok)),
+        ("d", Optional(&d)),
+    ];
+    let bytes = rotorid_io::write::parquet_columns_bytes("two_bad.parquet", &cols).unwrap();
+    std::fs::write(&path, bytes).unwrap();
+    for _ in 0..10 {
+        let out = rotorid()
+            .args(["inspect", path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(
+            stderr.contains("channel \"b\"") && stderr.contains("row 99000 of row group 0"),
+            "{stderr}"
+        );
+    }
+}
+
+#[test]
 fn a_panic_of_the_parquet_crate_is_an_error_without_a_panic_message() {
     // Found by fuzzing read_parquet: a BYTE_STREAM_SPLIT page shorter than its value count,
     // on which the parquet crate (59.3.2) indexes out of bounds. rotorid reports an error
