@@ -145,6 +145,7 @@ pub struct ParquetBlocks {
 
 /// Where one column's reading stands: its row group, that chunk's reader and batch state,
 /// and the values given so far.
+#[derive(Default)]
 struct ColumnCursor {
     row_group: usize,
     reader: Option<ColumnReader>,
@@ -174,6 +175,7 @@ impl crate::stream::RowBlocks for ParquetBlocks {
         max_rows: usize,
         out: &mut [Vec<f64>],
     ) -> Result<usize, ReadError> {
+        crate::stream::check_wanted(&self.file, self.channels.len(), wanted, out)?;
         let Some(&first) = wanted.first() else {
             return Ok(0);
         };
@@ -181,20 +183,14 @@ impl crate::stream::RowBlocks for ParquetBlocks {
         let n = max_rows.min(self.channels[first].len.saturating_sub(given));
         let file = self.file.as_str();
         let opened = &self.opened;
-        // each column asked for, with its cursor and output (wanted is distinct)
+        // each column asked for, with its cursor and output (distinct and in range: checked)
         let mut cursors: Vec<Option<&mut Option<ColumnCursor>>> =
             self.cursors.iter_mut().map(Some).collect();
-        let mut jobs = Vec::with_capacity(wanted.len());
-        for (&k, data) in wanted.iter().zip(out.iter_mut()) {
-            let Some(cursor) = cursors.get_mut(k).and_then(Option::take) else {
-                return Err(err(
-                    file,
-                    None,
-                    format!("column {k} asked for twice or absent"),
-                ));
-            };
-            jobs.push(std::sync::Mutex::new((k, cursor, data)));
-        }
+        let jobs: Vec<_> = wanted
+            .iter()
+            .zip(out.iter_mut())
+            .filter_map(|(&k, data)| Some(std::sync::Mutex::new((k, cursors[k].take()?, data))))
+            .collect();
         // Columns side by side from PARALLEL_FROM bytes a block on, as the whole-file read
         // decodes them; the first error in column order is the one reported.
         let bytes = (n as u64).saturating_mul(8 * wanted.len() as u64);
@@ -203,7 +199,7 @@ impl crate::stream::RowBlocks for ParquetBlocks {
             let mut job = job.lock().unwrap_or_else(|p| p.into_inner());
             let (k, cursor, data) = &mut *job;
             let c = &opened.wanted[*k];
-            let cursor = cursor.get_or_insert_with(ColumnCursor::new);
+            let cursor = cursor.get_or_insert_with(ColumnCursor::default);
             // A panic of the crate in this column names it (crate::guard).
             crate::guard::quietly(|| fill(file, opened, c, cursor, n, data))
                 .unwrap_or_else(|| Err(cursor_undecodable(file, opened, c, cursor)))
@@ -212,23 +208,6 @@ impl crate::stream::RowBlocks for ParquetBlocks {
             r.unwrap_or_else(|| Err(err(file, None, "a column reader failed")))?;
         }
         Ok(n)
-    }
-}
-
-impl ColumnCursor {
-    fn new() -> Self {
-        Self {
-            row_group: 0,
-            reader: None,
-            batch: Batch {
-                defs: Vec::new(),
-                row0: 0,
-                index0: 0,
-                data_start: 0,
-            },
-            in_chunk: 0,
-            given: 0,
-        }
     }
 }
 
@@ -652,12 +631,7 @@ fn read_chunk<R: ChunkReader + 'static>(
     data: &mut Vec<f64>,
 ) -> Result<(), ReadError> {
     let mut col_reader = column_reader(file, reader, col, at)?;
-    let mut batch = Batch {
-        defs: Vec::new(),
-        row0: 0,
-        index0: 0,
-        data_start: 0,
-    };
+    let mut batch = Batch::default();
     loop {
         let n = batch.read(file, &mut col_reader, kind, max_def, at, BATCH, data)?;
         if n == 0 {
@@ -687,6 +661,7 @@ fn column_reader<R: ChunkReader + 'static>(
 }
 
 /// Where a column chunk's reading stands, for [`Batch::read`] and its messages.
+#[derive(Default)]
 struct Batch {
     /// Definition levels of the last batch (scratch).
     defs: Vec<i16>,

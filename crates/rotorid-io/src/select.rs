@@ -49,6 +49,11 @@ impl Default for ColumnMap {
 }
 
 impl ColumnMap {
+    /// The map `--columns SPEC` gives, or the default names without it.
+    pub fn from_spec(spec: Option<&str>) -> Result<Self, SelectError> {
+        spec.map_or_else(|| Ok(Self::default()), Self::parse)
+    }
+
     /// Parse `t,x,z` or `t,x,z,phi,phi_dot,phi_ddot` (names separated by commas, blanks
     /// around them ignored). With three names the speed channels keep their default names.
     pub fn parse(spec: &str) -> Result<Self, SelectError> {
@@ -198,29 +203,21 @@ pub struct Used {
 /// for the first). Every check runs before anything is moved.
 pub fn select(mut table: Table, map: &ColumnMap) -> Result<SiColumns, SelectError> {
     let plan = plan(&table.file, &table.channels, map)?;
-    let mut uses = vec![0_usize; table.channels.len()];
-    for &(_, i, _) in &plan.order {
-        uses[i] += 1;
-    }
-    let mut out: [Vec<f64>; 6] = Default::default();
-    let mut used = Vec::with_capacity(plan.order.len());
-    for &(role, i, conv) in &plan.order {
-        let c = &mut table.channels[i];
-        uses[i] -= 1;
-        let mut data = if uses[i] == 0 {
-            std::mem::take(&mut c.data)
-        } else {
-            c.data.clone()
-        };
-        conv.apply_all(&mut data);
-        out[role] = data;
-        used.push(Used {
+    let used = plan
+        .order
+        .iter()
+        .map(|&(role, i, conv)| Used {
             role: ROLES[role],
-            channel: c.name.clone(),
+            channel: table.channels[i].name.clone(),
             conversion: conv,
-        });
-    }
-    let [t, x, z, phi, phi_dot, phi_ddot] = out;
+        })
+        .collect();
+    let mut buffers: Vec<Vec<f64>> = table
+        .channels
+        .iter_mut()
+        .map(|c| std::mem::take(&mut c.data))
+        .collect();
+    let [t, x, z, phi, phi_dot, phi_ddot] = into_roles(&plan.order, &mut buffers);
     Ok(SiColumns {
         t: match plan.axis {
             Some((axis, n)) => axis.times(n),
@@ -232,6 +229,31 @@ pub fn select(mut table: Table, map: &ColumnMap) -> Result<SiColumns, SelectErro
         used,
         time_from_axis: plan.axis.is_some(),
     })
+}
+
+/// The columns by role of `order` ((role, buffer index, conversion), as [`Plan::order`]):
+/// each buffer of `buffers` moved to its role and converted to SI in place; a buffer that
+/// plays two roles is copied for the first. The roles not in `order` are empty.
+pub(crate) fn into_roles(
+    order: &[(usize, usize, Conversion)],
+    buffers: &mut [Vec<f64>],
+) -> [Vec<f64>; 6] {
+    let mut uses = vec![0_usize; buffers.len()];
+    for &(_, i, _) in order {
+        uses[i] += 1;
+    }
+    let mut out: [Vec<f64>; 6] = Default::default();
+    for &(role, i, conv) in order {
+        uses[i] -= 1;
+        let mut data = if uses[i] == 0 {
+            std::mem::take(&mut buffers[i])
+        } else {
+            buffers[i].clone()
+        };
+        conv.apply_all(&mut data);
+        out[role] = data;
+    }
+    out
 }
 
 /// What [`select`] takes from a table, checked: (role, channel index, conversion to SI) in

@@ -17,12 +17,9 @@ use std::path::Path;
 
 use crate::error::ReadError;
 use crate::format::Format;
-use crate::select::{plan, ColumnMap, SelectError, Used, ROLES};
+use crate::select::{into_roles, plan, ColumnMap, SelectError, Used, ROLES};
 use crate::table::{ChannelInfo, TimeAxis};
 use crate::units::Conversion;
-
-/// Rows a block holds at most by default: 65,536 rows of six channels are 3 MiB.
-pub const DEFAULT_BLOCK_ROWS: usize = 1 << 16;
 
 /// A file read a block of rows at a time (module doc).
 pub trait RowBlocks: Send {
@@ -48,6 +45,31 @@ pub trait RowBlocks: Send {
         max_rows: usize,
         out: &mut [Vec<f64>],
     ) -> Result<usize, ReadError>;
+}
+
+/// The check every [`RowBlocks::next_rows`] makes of its arguments: `wanted` holds
+/// distinct indices below `channels`, and `out` one list for each.
+pub(crate) fn check_wanted(
+    file: &str,
+    channels: usize,
+    wanted: &[usize],
+    out: &[Vec<f64>],
+) -> Result<(), ReadError> {
+    let distinct = wanted
+        .iter()
+        .enumerate()
+        .all(|(j, &k)| k < channels && !wanted[..j].contains(&k));
+    if distinct && wanted.len() == out.len() {
+        return Ok(());
+    }
+    Err(ReadError::Invalid {
+        file: file.to_owned(),
+        channel: None,
+        offset: 0,
+        what: "channels asked for".into(),
+        found: format!("{wanted:?} with {} lists to fill", out.len()),
+        allowed: format!("distinct indices below {channels}, one list each"),
+    })
 }
 
 /// The file at `path` read a block at a time, when its format allows it (TDMS, Parquet);
@@ -269,23 +291,8 @@ impl SiBlocks {
                 self.done + n,
             ));
         }
-        // each channel's buffer becomes its (first) role's column, converted in place; a
-        // channel that plays two roles is copied for the first
-        let mut uses = vec![0_usize; raw.len()];
-        for &(_, k, _) in &self.order {
-            uses[k] += 1;
-        }
-        let mut out: [Vec<f64>; 6] = Default::default();
-        for &(role, k, conv) in &self.order {
-            uses[k] -= 1;
-            let mut data = if uses[k] == 0 {
-                std::mem::take(&mut raw[k])
-            } else {
-                raw[k].clone()
-            };
-            conv.apply_all(&mut data);
-            out[role] = data;
-        }
+        // each channel's buffer becomes its (first) role's column, converted in place
+        let out = into_roles(&self.order, &mut raw);
         let first = self.done;
         self.done += n;
         let [t, x, z, phi, phi_dot, phi_ddot] = out;

@@ -50,10 +50,7 @@ pub fn read_any(path: &str, columns: Option<&str>) -> Result<Response, Error> {
         return read(path);
     }
     let table = rotorid_io::read_table(path)?;
-    let map = match columns {
-        Some(spec) => rotorid_io::ColumnMap::parse(spec)?,
-        None => rotorid_io::ColumnMap::default(),
-    };
+    let map = rotorid_io::ColumnMap::from_spec(columns)?;
     let notes = table.notes.clone();
     let s = rotorid_io::select(table, &map)?;
     Ok(Response {
@@ -108,10 +105,7 @@ pub fn open_blocks(path: &str, columns: Option<&str>, rows: usize) -> Result<Blo
         });
     };
     let notes = reader.notes().to_vec();
-    let map = match columns {
-        Some(spec) => rotorid_io::ColumnMap::parse(spec)?,
-        None => rotorid_io::ColumnMap::default(),
-    };
+    let map = rotorid_io::ColumnMap::from_spec(columns)?;
     let blocks = rotorid_io::SiBlocks::new(reader, &map)?;
     Ok(BlockReader {
         rows,

@@ -370,25 +370,6 @@ impl TdmsBlocks {
     pub fn peak_queued_bytes(&self) -> usize {
         self.peak
     }
-
-    fn asked(&self, wanted: &[usize], out: &[Vec<f64>]) -> Result<(), ReadError> {
-        let n = self.channels.len();
-        let distinct = wanted
-            .iter()
-            .enumerate()
-            .all(|(j, &k)| k < n && !wanted[..j].contains(&k));
-        if distinct && wanted.len() == out.len() {
-            return Ok(());
-        }
-        Err(ReadError::Invalid {
-            file: self.file.clone(),
-            channel: None,
-            offset: 0,
-            what: "channels asked for".into(),
-            found: format!("{wanted:?} with {} lists to fill", out.len()),
-            allowed: format!("distinct indices below {n}, one list each"),
-        })
-    }
 }
 
 impl crate::stream::RowBlocks for TdmsBlocks {
@@ -410,7 +391,7 @@ impl crate::stream::RowBlocks for TdmsBlocks {
         max_rows: usize,
         out: &mut [Vec<f64>],
     ) -> Result<usize, ReadError> {
-        self.asked(wanted, out)?;
+        crate::stream::check_wanted(&self.file, self.channels.len(), wanted, out)?;
         let n = wanted
             .iter()
             .map(|&k| self.channels[k].len - self.streams[k].given)
