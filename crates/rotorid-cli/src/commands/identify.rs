@@ -50,17 +50,16 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         tables::print_report(&c);
         let cols = tables::conditioned_columns(c);
         (args.input.clone(), stream::Source::Columns(cols))
-    } else if let Some(blocks) = tables::is_tabular(&args.input, columns)
-        .then(|| tables::blocks(&args.input, columns))
-        .transpose()?
-        .flatten()
-    {
-        // a TDMS or Parquet file: read a block of rows at a time as it is identified
-        (args.input.clone(), stream::Source::Blocks(blocks))
     } else if tables::is_tabular(&args.input, columns) {
-        let table = tables::read(&args.input)?;
-        let cols = tables::columns(table, columns)?;
-        (args.input.clone(), stream::Source::Columns(cols))
+        // a TDMS or Parquet file is read a block of rows at a time as it is identified
+        let source = match tables::blocks(&args.input, columns)? {
+            Some(blocks) => stream::Source::Blocks(blocks),
+            None => {
+                let table = tables::read(&args.input)?;
+                stream::Source::Columns(tables::columns(table, columns)?)
+            }
+        };
+        (args.input.clone(), source)
     } else {
         if columns.is_some() {
             anyhow::bail!(

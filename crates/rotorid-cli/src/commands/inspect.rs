@@ -143,9 +143,7 @@ fn streamed(
     path: &str,
     reader: Box<dyn rotorid_io::RowBlocks>,
 ) -> anyhow::Result<(String, Vec<Summary>)> {
-    for n in reader.notes() {
-        eprintln!("note: {}: {n}", reader.file());
-    }
+    tables::print_notes(reader.file(), reader.notes());
     let file = reader.file().to_owned();
     let infos = reader.channels().to_vec();
     let threads = std::thread::available_parallelism()

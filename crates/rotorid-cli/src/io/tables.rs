@@ -32,10 +32,16 @@ pub fn is_tabular(input: &str, columns: Option<&str>) -> bool {
 /// about the file (an interrupted recording's unfinished chunk) as `note:` lines on stderr.
 pub fn read(path: &str) -> anyhow::Result<Table> {
     let table = rotorid_io::read_table(path)?;
-    for n in &table.notes {
-        eprintln!("note: {}: {n}", table.file);
-    }
+    print_notes(&table.file, &table.notes);
     Ok(table)
+}
+
+/// What a reader noted about `file` (an interrupted recording's unfinished chunk), as
+/// `note:` lines on stderr.
+pub fn print_notes(file: &str, notes: &[String]) {
+    for n in notes {
+        eprintln!("note: {file}: {n}");
+    }
 }
 
 /// The channels of `table` that play t, x, z and (when present) phi, phi_dot, phi_ddot, in
@@ -43,7 +49,7 @@ pub fn read(path: &str) -> anyhow::Result<Table> {
 /// table is consumed: its channels become the columns without a copy.
 pub fn columns(table: Table, columns: Option<&str>) -> anyhow::Result<SiColumns> {
     let file = table.file.clone();
-    let cols = select(table, &column_map(columns)?)?;
+    let cols = select(table, &ColumnMap::from_spec(columns)?)?;
     print_selection(&file, &cols.used, cols.time_from_axis);
     Ok(cols)
 }
@@ -57,20 +63,10 @@ pub fn blocks(path: &str, columns: Option<&str>) -> anyhow::Result<Option<SiBloc
     let Some(reader) = rotorid_io::open_blocks(path)? else {
         return Ok(None);
     };
-    for n in reader.notes() {
-        eprintln!("note: {}: {n}", reader.file());
-    }
-    let blocks = SiBlocks::new(reader, &column_map(columns)?)?;
+    print_notes(reader.file(), reader.notes());
+    let blocks = SiBlocks::new(reader, &ColumnMap::from_spec(columns)?)?;
     print_selection(blocks.file(), blocks.used(), blocks.time_from_axis());
     Ok(Some(blocks))
-}
-
-/// The `--columns` text as a map (the default names without it).
-fn column_map(columns: Option<&str>) -> anyhow::Result<ColumnMap> {
-    Ok(match columns {
-        Some(spec) => ColumnMap::parse(spec)?,
-        None => ColumnMap::default(),
-    })
 }
 
 /// The notes on stderr of the channels `used` of `file` that were converted to SI, and of
