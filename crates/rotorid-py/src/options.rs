@@ -161,6 +161,10 @@ fn unknowns(names: Option<&[String]>) -> Result<Unknowns, Error> {
     }
     let has = |n: &str| names.iter().any(|m| m == n);
     Ok(Unknowns {
+        cxz: false,
+        czx: false,
+        kxz: false,
+        kzx: false,
         m: has("m"),
         cx: has("cx"),
         kx: has("kx"),

@@ -292,6 +292,7 @@ pub(crate) fn modulating_bound(
         Some((r, _)) => (r, None, CrbAt::TruthParameters),
         None => (
             RotorParams {
+                coupling: None,
                 m: 0.5 * (values[0] + values[3]),
                 cx: values[1],
                 kx: values[2],
@@ -308,16 +309,7 @@ pub(crate) fn modulating_bound(
     let initial = match known_ic {
         Some(ic) => ic,
         None => {
-            let only_initial_state = Unknowns {
-                m: false,
-                cx: false,
-                kx: false,
-                cz: false,
-                kz: false,
-                a: false,
-                unbalance: false,
-                initial_state: true,
-            };
+            let only_initial_state = Unknowns::initial_state_only();
             let options = RefineOptions {
                 unknowns: only_initial_state,
                 ..RefineOptions::default()
@@ -342,6 +334,7 @@ fn true_rotor(k: &Knowledge) -> Option<(RotorParams, Option<InitialState>)> {
         let v = &t.values;
         Some((
             RotorParams {
+                coupling: None,
                 m: v.m?,
                 cx: v.cx?,
                 kx: v.kx?,

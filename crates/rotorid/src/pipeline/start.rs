@@ -142,6 +142,7 @@ pub(crate) fn start(
 /// Rotor parameters with m, cx, kx, cz, kz from `mck` and a, unbalance from `k`.
 fn with_mck(mck: [f64; 5], k: &Knowledge) -> RotorParams {
     RotorParams {
+        coupling: None,
         m: mck[0],
         cx: mck[1],
         kx: mck[2],

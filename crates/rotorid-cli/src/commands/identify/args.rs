@@ -351,6 +351,10 @@ fn unknowns_of(names: Option<&[UnknownName]>) -> Unknowns {
     };
     let has = |n: UnknownName| names.contains(&n);
     Unknowns {
+        cxz: false,
+        czx: false,
+        kxz: false,
+        kzx: false,
         m: has(UnknownName::M),
         cx: has(UnknownName::Cx),
         kx: has(UnknownName::Kx),
