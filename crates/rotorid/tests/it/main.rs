@@ -18,6 +18,7 @@ mod modulating_noise;
 mod pipeline;
 mod refine_clean;
 mod refine_crb;
+mod refine_cross;
 mod refine_identifiability;
 mod refine_inputs;
 mod refine_model;
