@@ -87,10 +87,11 @@ pub enum Sign {
 }
 
 /// A rotor model: which parameters it has (docs/method.md section 1.7).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ModelKind {
     /// The paper's rotor: m, cx, kx, cz, kz, a and the unbalance.
+    #[default]
     Jeffcott,
     /// The same rotor on bearings with all eight coefficients: m, cxx, cxz, czx, czz, kxx,
     /// kxz, kzx, kzz, a and the unbalance.

@@ -192,6 +192,21 @@ pub enum Finding {
         /// Why.
         reason: String,
     },
+    /// `--model auto` chose this model (the summary's `model_selection` has the figures).
+    ModelSelected {
+        /// The model taken.
+        model: crate::parameter::ModelKind,
+        /// Why, in words.
+        reason: String,
+    },
+    /// The model fitted leaves structure in its residuals that another model explains.
+    OtherModelExplains {
+        /// The model whose residuals pass the adequacy test.
+        model: crate::parameter::ModelKind,
+        /// BIC of the fitted model minus that of the other (positive: the other is
+        /// better).
+        bic_difference: f64,
+    },
 }
 
 /// A finding with its severity and message (module doc).
@@ -214,6 +229,14 @@ impl Diagnostic {
             finding,
             severity: Severity::Warning,
             message,
+        }
+    }
+
+    /// A finding worth knowing that leaves the numbers standing ([`Severity::Note`]).
+    pub(crate) fn note(finding: Finding) -> Self {
+        Self {
+            severity: Severity::Note,
+            ..Self::new(finding)
         }
     }
 
@@ -407,6 +430,20 @@ fn message(f: &Finding) -> String {
         Finding::CrbUnavailable { reason } => {
             format!("the Cramer-Rao bound was not computed: {reason}")
         }
+        Finding::ModelSelected { model, reason } => {
+            format!("model {model} (chosen by --model auto): {reason}")
+        }
+        Finding::OtherModelExplains {
+            model,
+            bic_difference,
+        } => format!(
+            "{} explain these data: the {model} model's residuals pass the adequacy test (BIC \
+             lower by {bic_difference:.1}); identify with --model {model} or --model auto",
+            match model {
+                crate::parameter::ModelKind::CrossCoupled => "cross-coupled bearings",
+                crate::parameter::ModelKind::Jeffcott => "a Jeffcott rotor",
+            }
+        ),
         // The refinement's findings are made from its warnings (`From<&Warning>`), which
         // carry their own sentences; this is only their fallback.
         other => format!("{other:?}"),

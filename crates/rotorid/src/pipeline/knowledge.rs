@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::identify::Known;
 use crate::model::{InitialState, RotorParams, Scenario, Unbalance};
-use crate::parameter::Parameter;
+use crate::parameter::{ModelKind, Parameter};
 
 /// Values of m \[kg\], the damping \[N s/m\] and stiffness \[N/m\] coefficients, each
 /// possibly unknown. The direct coefficients cx, kx, cz, kz are the cross-coupled model's
@@ -95,6 +95,10 @@ pub struct Truth {
 /// What is known besides the record (module doc).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Knowledge {
+    /// The rotor model the caller describes (the scenario's `rotor.model`): the model of
+    /// an identification whose method names none.
+    #[serde(default)]
+    pub model: ModelKind,
     /// Gyroscopic coefficient a \[N s^2/m\].
     pub a: f64,
     /// The unbalance m_u \[kg\], d \[m\], alpha \[rad\] (only m_u d and alpha matter).
@@ -110,6 +114,7 @@ impl Knowledge {
     /// Only what eq. (1) needs as known: a, the unbalance; no nominal values, no truth.
     pub fn known(a: f64, unbalance: Unbalance) -> Self {
         Self {
+            model: ModelKind::Jeffcott,
             a,
             unbalance,
             nominal: RotorValues::default(),
@@ -122,6 +127,7 @@ impl Knowledge {
     pub fn from_scenario(s: &Scenario) -> Self {
         let p = s.rotor.params();
         Self {
+            model: p.model(),
             a: p.a,
             unbalance: p.unbalance,
             nominal: RotorValues::of(&p),

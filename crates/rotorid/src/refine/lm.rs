@@ -605,7 +605,7 @@ fn assemble(
         covariance: (0..n)
             .map(|i| fi.cov[i * n..(i + 1) * n].to_vec())
             .collect(),
-        covariance_names: cols.kinds().iter().map(|k| k.name()).collect(),
+        covariance_names: cols.kinds().iter().map(|k| k.name_in(cols.model)).collect(),
         robust: robust.map(|r| RobustCovariance {
             bandwidth: r.bandwidth,
             residual_lag1_autocorrelation: r.rho,

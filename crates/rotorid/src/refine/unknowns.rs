@@ -258,23 +258,39 @@ pub(crate) struct Columns {
 }
 
 impl Columns {
-    /// The columns of `u` in `model` (the Jeffcott order m, cx, kx, cz, kz, a, u_c, u_s,
-    /// then the cross terms cxz, czx, kxz, kzx, then the initial state).
+    /// The columns of `u` in `model`, in the model's order of parameters
+    /// ([`ModelKind::parameters`]; the unbalance as u_c, u_s), then the initial state.
     pub(crate) fn new(u: &Unknowns, model: ModelKind) -> Self {
-        let phys = [
-            (u.m, Kind::M),
-            (u.cx, Kind::Cx),
-            (u.kx, Kind::Kx),
-            (u.cz, Kind::Cz),
-            (u.kz, Kind::Kz),
-            (u.a, Kind::A),
-            (u.unbalance, Kind::Uc),
-            (u.unbalance, Kind::Us),
-            (u.cxz, Kind::Cxz),
-            (u.czx, Kind::Czx),
-            (u.kxz, Kind::Kxz),
-            (u.kzx, Kind::Kzx),
-        ];
+        let phys = match model {
+            ModelKind::Jeffcott => [
+                (u.m, Kind::M),
+                (u.cx, Kind::Cx),
+                (u.kx, Kind::Kx),
+                (u.cz, Kind::Cz),
+                (u.kz, Kind::Kz),
+                (u.a, Kind::A),
+                (u.unbalance, Kind::Uc),
+                (u.unbalance, Kind::Us),
+                (u.cxz, Kind::Cxz),
+                (u.czx, Kind::Czx),
+                (u.kxz, Kind::Kxz),
+                (u.kzx, Kind::Kzx),
+            ],
+            ModelKind::CrossCoupled => [
+                (u.m, Kind::M),
+                (u.cx, Kind::Cx),
+                (u.cxz, Kind::Cxz),
+                (u.czx, Kind::Czx),
+                (u.cz, Kind::Cz),
+                (u.kx, Kind::Kx),
+                (u.kxz, Kind::Kxz),
+                (u.kzx, Kind::Kzx),
+                (u.kz, Kind::Kz),
+                (u.a, Kind::A),
+                (u.unbalance, Kind::Uc),
+                (u.unbalance, Kind::Us),
+            ],
+        };
         let ic = [Kind::X0, Kind::Z0, Kind::Vx0, Kind::Vz0].map(|k| (u.initial_state, k));
         let mut kinds = [Kind::M; MAXP];
         let mut n = 0;

@@ -61,8 +61,9 @@ pub enum ScenarioFileError {
     },
     /// A key that its section does not have.
     #[error(
-        "{}: unknown key {section}.{key}; allowed keys in [{section}]: {allowed}",
-        At(origin, line)
+        "{}: unknown key {section}.{key}; allowed keys in [{section}]: {allowed}{}",
+        At(origin, line),
+        hint.as_deref().map_or(String::new(), |h| format!(" ({h})"))
     )]
     UnknownKey {
         /// The file name.
@@ -75,6 +76,9 @@ pub enum ScenarioFileError {
         key: String,
         /// The section's keys, comma-separated.
         allowed: String,
+        /// Where the key belongs, when it is another model's
+        /// (`kxx is a key of rotor.model = "cross_coupled"`).
+        hint: Option<String>,
     },
     /// A value of the wrong TOML type (`rotor.m = "heavy"`).
     #[error(

@@ -396,6 +396,7 @@ impl ScenarioSpec {
         };
         let initial = self.simulation(&grid).ok().map(|s| s.initial);
         Ok(crate::pipeline::Knowledge {
+            model: self.model,
             a: v.a,
             unbalance: Unbalance {
                 m_u: v.m_u,
@@ -1053,6 +1054,126 @@ initial = { x = 1e-6 }
             e.to_string(),
             "rig.toml: missing section [rotor] (a, m_u, d, alpha_deg and, to simulate, m, cx, \
              cz, kx, kz)"
+        );
+    }
+
+    const CROSS: &str = r#"
+[rotor]
+model = "cross_coupled"
+m = 14.29
+a = 2.871
+kxx = 1.195e6
+kxz = -3.0e4
+kzx = 3.0e4
+kzz = 1.4e6
+cxx = 200.0
+cxz = 20.0
+czx = -5.0
+czz = 200.0
+m_u = 1.0e-4
+d = 0.15
+alpha_deg = 45.0
+[speed]
+kind = "constant"
+rpm = 1200.0
+[sampling]
+dt = 1.0e-4
+duration = 1.0
+"#;
+
+    #[test]
+    fn a_cross_coupled_rotor_reads_with_its_own_keys() {
+        let spec = ScenarioSpec::parse("c.toml", CROSS).unwrap();
+        assert_eq!(spec.model(), ModelKind::CrossCoupled);
+        let sc = spec.simulation(&SimulationOverrides::default()).unwrap();
+        let p = sc.rotor.params();
+        let c = p.coupling.expect("cross-coupled");
+        assert_eq!((p.kx, p.kz, p.cx, p.cz), (1.195e6, 1.4e6, 200.0, 200.0));
+        assert_eq!((c.kxz, c.kzx, c.cxz, c.czx), (-3.0e4, 3.0e4, 20.0, -5.0));
+        let id = spec.identification().unwrap();
+        assert_eq!(id.model, ModelKind::CrossCoupled);
+        assert_eq!((id.truth.kxz, id.truth.czx), (Some(-3.0e4), Some(-5.0)));
+        let k = spec.knowledge().unwrap();
+        assert_eq!(k.model, ModelKind::CrossCoupled);
+        // --model jeffcott: the same rotor without its cross terms
+        let j = spec.clone().with_model(ModelKind::Jeffcott);
+        let sj = j.simulation(&SimulationOverrides::default()).unwrap();
+        assert_eq!(sj.rotor.params().coupling, None);
+        assert_eq!(j.identification().unwrap().truth.kxz, None);
+        // a Jeffcott file in the cross-coupled model: zero cross terms, stated as such
+        let t = table1().with_model(ModelKind::CrossCoupled);
+        let st = t.simulation(&SimulationOverrides::default()).unwrap();
+        assert_eq!(st.rotor.params().coupling, Some(CrossCoupling::default()));
+        let file = ScenarioSpec::parse("s.toml", TABLE1)
+            .unwrap()
+            .with_model(ModelKind::CrossCoupled);
+        let truth = file.identification().unwrap().truth;
+        assert_eq!((truth.kx, truth.kzx), (Some(1.195e6), Some(0.0)));
+        assert_eq!(
+            file.simulation(&SimulationOverrides::default())
+                .unwrap()
+                .rotor
+                .params()
+                .coupling,
+            Some(CrossCoupling::default())
+        );
+    }
+
+    #[test]
+    fn cross_coupled_errors_name_the_key_the_value_and_the_range() {
+        let e = |text: &str| ScenarioSpec::parse("c.toml", text).unwrap_err().to_string();
+        // the symmetric part of [[200, 20], [-5, 200]] is fine; make it indefinite
+        let msg = e(&CROSS.replace("czx = -5.0", "czx = 500.0"));
+        assert!(
+            msg.starts_with("c.toml:2: rotor: the damping matrix [[cxx, cxz], [czx, czz]] = [[200, 20], [500, 200]] N s/m is not dissipative"),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("kzz = 1.4e6", "kzz = -1.4e6"));
+        assert!(
+            msg.starts_with(
+                "c.toml:9: rotor.kzz = -1400000 is out of range: must be finite and > 0 (N/m)"
+            ),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("cxx = 200.0", "cxx = -1.0"));
+        assert!(
+            msg.starts_with("c.toml:10: rotor.cxx = -1 is out of range"),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("kxz = -3.0e4", "kxz = nan"));
+        assert!(
+            msg.starts_with("c.toml:7: rotor.kxz = NaN is out of range: must be finite (N/m)"),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("kxx = 1.195e6", "kx = 1.195e6"));
+        assert!(
+            msg.starts_with("c.toml:6: unknown key rotor.kx; allowed keys in [rotor]: m, a, kxx")
+                && msg.ends_with("(kx is a key of rotor.model = \"jeffcott\")"),
+            "{msg}"
+        );
+        let msg = e(&TABLE1.replace("kx = 1.195e6", "kxz = 1.0"));
+        assert!(
+            msg.ends_with("(kxz is a key of rotor.model = \"cross_coupled\")"),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("\"cross_coupled\"", "\"fluid_film\""));
+        assert_eq!(
+            msg,
+            "c.toml:3: rotor.model = \"fluid_film\" is not a rotor model: must be \"jeffcott\" or \"cross_coupled\""
+        );
+        let msg = e(&CROSS.replace("\"cross_coupled\"", "2"));
+        assert!(
+            msg.starts_with("c.toml:3: rotor.model = 2 has the wrong type"),
+            "{msg}"
+        );
+        let spec = ScenarioSpec::parse("c.toml", &CROSS.replace("kzx = 3.0e4\n", "")).unwrap();
+        let msg = spec
+            .simulation(&SimulationOverrides::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.starts_with("c.toml: missing key rotor.kzx (N/m)"),
+            "{msg}"
         );
     }
 }

@@ -231,15 +231,24 @@ impl Parser<'_> {
                 let names = keys.iter().map(|(k, _)| *k);
                 let allowed: Vec<&str> = match name {
                     "speed" => std::iter::once("kind").chain(names).collect(),
-                    "rotor" => std::iter::once("model").chain(names).collect(),
+                    "rotor" => names.chain(std::iter::once("model")).collect(),
                     _ => names.collect(),
                 };
+                let hint = (name == "rotor")
+                    .then(|| {
+                        ModelKind::ALL.into_iter().find(|m| {
+                            rotor_keys(*m) != keys && rotor_keys(*m).iter().any(|(k, _)| *k == key)
+                        })
+                    })
+                    .flatten()
+                    .map(|m| format!("{key} is a key of rotor.model = \"{}\"", m.name()));
                 return Err(ScenarioFileError::UnknownKey {
                     origin: self.origin(),
                     line,
                     section: name.to_owned(),
                     key: key.to_owned(),
                     allowed: allowed.join(", "),
+                    hint,
                 });
             };
             let Raw::Number(value) = value else {
