@@ -13,6 +13,7 @@ mod identify_convergence;
 mod identify_modes;
 mod identify_quadrature;
 mod identify_validation;
+mod model_selection;
 mod modulating_clean;
 mod modulating_noise;
 mod pipeline;
