@@ -6,7 +6,7 @@
 //! the z equation of eq. (1) ([`Parameter::MX`], [`Parameter::MZ`]); the refinement fits
 //! one mass [`Parameter::M`] to both channels. The Jeffcott model names its bearing
 //! coefficients cx, kx, cz, kz; the cross-coupled model cxx, cxz, czx, czz, kxx, kxz, kzx,
-//! kzz (cxx is the Jeffcott model's cx, and so on; docs/method.md section 1.7).
+//! kzz (cxx is the Jeffcott model's cx, and so on; docs/method.md section 1.6).
 
 use std::fmt;
 use std::str::FromStr;
@@ -86,7 +86,7 @@ pub enum Sign {
     Any,
 }
 
-/// A rotor model: which parameters it has (docs/method.md section 1.7).
+/// A rotor model: which parameters it has (docs/method.md section 1.6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ModelKind {

@@ -85,7 +85,7 @@ pub fn table1_ramp(rpm0: f64) -> TestModel {
     TestModel::clean(&format!("table1_ramp{rpm0}"), s)
 }
 
-/// A rotor on cross-coupled bearings (docs/method.md section 1.7): table1's m, a and
+/// A rotor on cross-coupled bearings (docs/method.md section 1.6): table1's m, a and
 /// unbalance on stiffer, anisotropic, well damped bearings (kxx = 1.195e6, kzz = 1.4e6 N/m,
 /// cxx = czz = 200 N s/m: damping ratio 2.4 %) with a destabilising cross-coupled
 /// stiffness kxz = -kzx = -3e4 N/m (2.5 % of kxx; it drives forward whirl and halves its

@@ -1,6 +1,6 @@
 //! Rotor parameters and the M, C(w), K(w') matrices and unbalance force of eq. (1), for
 //! the paper's Jeffcott rotor and for the same rotor on cross-coupled bearings
-//! (docs/method.md section 1.7):
+//! (docs/method.md section 1.6):
 //!
 //! ```text
 //! C(w)  = [[cx, cxz], [czx, cz]] + w  [[0, -a], [a, 0]]

@@ -263,7 +263,7 @@ impl std::fmt::Display for Diagnostic {
 impl From<&Warning> for Diagnostic {
     fn from(w: &Warning) -> Self {
         let finding = match w {
-            Warning::NotIdentifiable { parameters } => Finding::NotIdentifiable {
+            Warning::NotIdentifiable { parameters, .. } => Finding::NotIdentifiable {
                 quantities: parameters.iter().map(|s| (*s).to_owned()).collect(),
             },
             Warning::IllConditioned {

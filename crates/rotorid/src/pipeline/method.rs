@@ -35,7 +35,7 @@ impl MethodName {
     }
 }
 
-/// The rotor model an identification uses (docs/method.md section 1.7, 6.6).
+/// The rotor model an identification uses (docs/method.md sections 1.6 and 6.6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ModelChoice {

@@ -553,7 +553,17 @@ fn assemble(
             last_step: s.last_step,
         });
     }
-    let id_warnings = identifiability_warnings(&rs, fi.condition_number);
+    let mut id_warnings = identifiability_warnings(&rs, fi.condition_number);
+    if s.no_transient.is_some() {
+        for w in &mut id_warnings {
+            if let Warning::NotIdentifiable {
+                steady_state_only, ..
+            } = w
+            {
+                *steady_state_only = true;
+            }
+        }
+    }
     let identifiable = id_warnings.is_empty();
     warnings.extend(id_warnings);
     for r in rs.iter().filter(|r| !r.initial && r.unphysical) {

@@ -70,6 +70,9 @@ pub enum Warning {
     NotIdentifiable {
         /// Names of the parameters concerned.
         parameters: Vec<&'static str>,
+        /// The record holds no significant free transient at constant speed: only the
+        /// steady-state response informs the fit (its message says what record would).
+        steady_state_only: bool,
     },
     /// The unknowns are so strongly correlated that the data barely separate them and the
     /// standard errors are numerically unreliable.
@@ -115,11 +118,23 @@ pub enum Warning {
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Warning::NotIdentifiable { parameters } => write!(
-                f,
-                "not identifiable from this record: {} (the data carry no information on them; values are arbitrary)",
-                parameters.join(", ")
-            ),
+            Warning::NotIdentifiable {
+                parameters,
+                steady_state_only,
+            } => {
+                write!(
+                    f,
+                    "not identifiable from this record: {} (the data carry no information on them; values are arbitrary)",
+                    parameters.join(", ")
+                )?;
+                if *steady_state_only {
+                    write!(
+                        f,
+                        ": a steady-state unbalance response at one speed gives two real equations per direction (the amplitude and phase of x and of z), which cannot separate mass, damping and stiffness, nor direct from cross-coupled bearing coefficients; a record with a start-up transient, a run-up or a coast-down can"
+                    )?;
+                }
+                Ok(())
+            }
             Warning::IllConditioned {
                 condition_number,
                 limit,
@@ -410,7 +425,10 @@ pub(crate) fn identifiability_warnings(rows: &[Row], condition_number: f64) -> V
         .collect();
     let any_unid = !unid.is_empty();
     if any_unid {
-        w.push(Warning::NotIdentifiable { parameters: unid });
+        w.push(Warning::NotIdentifiable {
+            parameters: unid,
+            steady_state_only: false,
+        });
     }
     if condition_number > CONDITION_LIMIT && !any_unid {
         w.push(Warning::IllConditioned {

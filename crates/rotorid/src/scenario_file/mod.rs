@@ -29,7 +29,7 @@
 //! vx = 0.0         # m/s        (vz likewise)
 //! ```
 //!
-//! `rotor.model` chooses the rotor model (docs/method.md section 1.7): `"jeffcott"` (the
+//! `rotor.model` chooses the rotor model (docs/method.md section 1.6): `"jeffcott"` (the
 //! default, the keys above) or `"cross_coupled"`, the same rotor on bearings with all eight
 //! coefficients, whose keys are m, a, kxx, kxz, kzx, kzz (N/m), cxx, cxz, czx, czz (N s/m),
 //! m_u, d, alpha_deg. Cross terms may have any sign; the direct stiffnesses must be > 0 and

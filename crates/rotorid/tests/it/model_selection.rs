@@ -24,7 +24,10 @@ fn rate(tm: &TestModel, want: ModelKind, seeds: std::ops::Range<u64>) -> f64 {
     let mut hits = 0;
     for seed in seeds {
         let id = run(&tm.with_noise(40.0, 7000 + seed), ModelChoice::Auto);
-        let sel = id.model_selection.as_ref().expect("auto records its selection");
+        let sel = id
+            .model_selection
+            .as_ref()
+            .expect("auto records its selection");
         assert_eq!(sel.chosen, id.model);
         assert_eq!(sel.candidates.len(), 2, "{}: {}", tm.name, sel.reason);
         if id.model == want {
@@ -34,7 +37,11 @@ fn rate(tm: &TestModel, want: ModelKind, seeds: std::ops::Range<u64>) -> f64 {
         }
     }
     let r = hits as f64 / n;
-    println!("{}: auto takes {want} in {:.0}% of {n} seeds", tm.name, 100.0 * r);
+    println!(
+        "{}: auto takes {want} in {:.0}% of {n} seeds",
+        tm.name,
+        100.0 * r
+    );
     r
 }
 
@@ -58,7 +65,10 @@ fn the_selection_is_reported_with_every_candidate() {
     assert_eq!(id.model, ModelKind::CrossCoupled);
     let sel = id.model_selection.unwrap();
     let [j, c] = [&sel.candidates[0], &sel.candidates[1]];
-    assert_eq!((j.model, c.model), (ModelKind::Jeffcott, ModelKind::CrossCoupled));
+    assert_eq!(
+        (j.model, c.model),
+        (ModelKind::Jeffcott, ModelKind::CrossCoupled)
+    );
     assert_eq!((j.adequate, c.adequate), (Some(false), Some(true)));
     assert!(c.bic < j.bic && c.estimated == j.estimated + 4, "{sel:?}");
     // ln L = -N/2 (ln(2 pi s^2) + 1) per channel, and BIC = -2 ln L + k ln(2 N)
@@ -68,7 +78,12 @@ fn the_selection_is_reported_with_every_candidate() {
     let want = ll(noise.sigma_x_m) + ll(noise.sigma_z_m);
     assert!((c.log_likelihood - want).abs() < 1e-9 * want.abs());
     assert!((c.bic - (-2.0 * want + c.estimated as f64 * (2.0 * n).ln())).abs() < 1e-6);
-    assert!(sel.reason.starts_with("cross-coupled bearings explain these data"), "{}", sel.reason);
+    assert!(
+        sel.reason
+            .starts_with("cross-coupled bearings explain these data"),
+        "{}",
+        sel.reason
+    );
     let note = id
         .diagnostics
         .iter()
@@ -76,7 +91,10 @@ fn the_selection_is_reported_with_every_candidate() {
         .expect("a note on the selection");
     assert_eq!(note.severity, Severity::Note);
     // the values are the cross-coupled model's, named as it names them
-    assert!(id.parameters.iter().any(|p| p.parameter.name() == "kxz" && p.determined));
+    assert!(id
+        .parameters
+        .iter()
+        .any(|p| p.parameter.name() == "kxz" && p.determined));
     assert_eq!(id.rotor.as_ref().unwrap().model(), ModelKind::CrossCoupled);
 }
 
@@ -92,7 +110,8 @@ fn a_jeffcott_fit_of_cross_coupled_data_is_flagged_and_pointed_to_the_other_mode
         .find(|d| matches!(d.finding, Finding::OtherModelExplains { .. }))
         .expect("a note that the cross-coupled model explains the data");
     assert!(
-        note.message.starts_with("cross-coupled bearings explain these data"),
+        note.message
+            .starts_with("cross-coupled bearings explain these data"),
         "{}",
         note.message
     );

@@ -1,4 +1,4 @@
-//! The cross-coupled rotor (docs/method.md section 1.7) through the refinement: exact data
+//! The cross-coupled rotor (docs/method.md section 1.6) through the refinement: exact data
 //! give back all nine parameters from a start several per cent off; at 40 dB the fit is
 //! efficient (RMS error within 2x the Cramer-Rao bound) and its 95 % intervals cover, at
 //! constant speed from rest and on a run-up; a steady-state record cannot separate the
@@ -206,14 +206,26 @@ fn a_steady_state_record_cannot_separate_direct_from_cross_terms() {
         .warnings
         .iter()
         .any(|w| matches!(w, Warning::NoSignificantTransient { .. })));
-    let not: Vec<&str> = r
+    let w = r
         .warnings
         .iter()
-        .find_map(|w| match w {
-            Warning::NotIdentifiable { parameters } => Some(parameters.clone()),
-            _ => None,
-        })
+        .find(|w| matches!(w, Warning::NotIdentifiable { .. }))
         .expect("a not-identifiable warning");
+    let Warning::NotIdentifiable {
+        parameters: not,
+        steady_state_only,
+    } = w
+    else {
+        unreachable!()
+    };
+    assert!(steady_state_only);
+    assert!(
+        w.to_string()
+            .contains("cannot separate mass, damping and stiffness, nor direct from cross-coupled")
+            && w.to_string()
+                .contains("a start-up transient, a run-up or a coast-down can"),
+        "{w}"
+    );
     for p in [
         Parameter::Kxz,
         Parameter::Kzx,
