@@ -21,7 +21,7 @@ def test_scenarios_three_ways(tmp_path, table1):
     f.write_text("[rotor]\na = 2.871\nm_u = 1e-4\nd = 0.15\nalpha_deg = 45\n[speed]\nkind = \"constant\"\nrpm = 1200\n")
     rig = rotorid.Scenario.from_toml(f)
     assert rig.origin == str(f)
-    assert rig.to_dict() == {"a": 2.871, "m_u": 1e-4, "d": 0.15, "alpha_deg": 45.0,
+    assert rig.to_dict() == {"model": "jeffcott", "a": 2.871, "m_u": 1e-4, "d": 0.15, "alpha_deg": 45.0,
                              "rpm": pytest.approx(1200), "phi0_deg": 0.0}
     assert rotorid.Scenario.load("table1").to_dict() == keys
     assert repr(table1) == "Scenario.table1()"
@@ -65,7 +65,7 @@ def test_repr_html_and_plot(noisy, clean, table1):
     res = rotorid.identify(noisy, table1, method="refine")
     html = res._repr_html_()
     assert "<table>" in html and "<td>kx</td>" in html and "N s/m" in html
-    assert repr(res).startswith("<rotorid.Identification method=refine samples=10001>")
+    assert repr(res).startswith("<rotorid.Identification method=refine samples=10001 model=jeffcott>")
     fig = res.plot()
     assert fig.axes and fig.axes[0].get_ylabel() == "relative to truth"
     fig = rotorid.identify(clean, table1, method="algebraic").plot()

@@ -6,9 +6,10 @@ import numpy as np
 
 from . import Scenario as Scenario
 
-__all__ = ["ESTIMATE_COLUMNS", "METHODS", "UNKNOWNS", "Blocks", "Scenario", "Session", "identify", "read", "read_blocks", "simulate"]
+__all__ = ["ESTIMATE_COLUMNS", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "identify", "read", "read_blocks", "simulate"]
 
 METHODS: list[str]
+MODELS: list[str]
 UNKNOWNS: list[str]
 ESTIMATE_COLUMNS: list[str]
 
@@ -43,6 +44,7 @@ def identify(
     phi_dot: Any = None,
     phi_ddot: Any = None,
     *,
+    model: str | None = None,
     unknowns: list[str] | None = None,
     quadrature: str | None = None,
     rcond_min: float | None = None,
@@ -64,6 +66,7 @@ class Session:
         dt: float | None = None,
         t0: float = 0.0,
         *,
+        model: str | None = None,
         unknowns: list[str] | None = None,
         quadrature: str | None = None,
         rcond_min: float | None = None,
