@@ -145,3 +145,19 @@ def test_schema_2_summaries_read_as_jeffcott(noisy, table1):
     assert old.model == "jeffcott" and old.model_selection is None
     assert old.warnings == ["old warning"] and old.notes == []
     assert set(old.to_ross_bearing_kwargs()) == {"kxx", "kyy", "cxx", "cyy"}
+
+
+@pytest.mark.parametrize("model", ["cross_coupled", "auto"])
+def test_session_takes_the_model(cross_record, model):
+    # a Session given the model ends as identify does on the whole record; the knowledge
+    # states no model (Jeffcott by default), so the option is what picks it
+    known = rotorid.Scenario(a=2.871, m_u=1e-4, d=0.15, alpha_deg=45.0, rpm=1200.0)
+    batch = rotorid.identify(cross_record, known, method="refine", model=model)
+    s = rotorid.Session(known, method="refine", dt=1e-4, model=model)
+    for i in range(0, len(cross_record), 2500):
+        c = cross_record.iloc[i:i + 2500]
+        s.push(c.x, c.z, phi=c.phi, phi_dot=c.phi_dot, phi_ddot=c.phi_ddot)
+    live = s.finish()
+    assert live.model == "cross_coupled"
+    d, b = live.to_dict(), batch.to_dict()
+    assert d["rotor"] == b["rotor"] and d["model_selection"] == b["model_selection"]
