@@ -60,6 +60,10 @@ pub enum Finding {
         condition_number: f64,
         /// The limit it exceeds.
         limit: f64,
+        /// The unknowns of the least informed direction (its near-null space), largest
+        /// share first.
+        #[serde(default)]
+        quantities: Vec<String>,
     },
     /// A standard error above the value itself (or 1 rad for alpha).
     PoorlyDetermined {
@@ -269,9 +273,11 @@ impl From<&Warning> for Diagnostic {
             Warning::IllConditioned {
                 condition_number,
                 limit,
+                parameters,
             } => Finding::IllConditioned {
                 condition_number: *condition_number,
                 limit: *limit,
+                quantities: parameters.iter().map(|s| (*s).to_owned()).collect(),
             },
             Warning::PoorlyDetermined {
                 parameter,

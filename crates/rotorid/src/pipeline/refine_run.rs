@@ -455,6 +455,7 @@ fn fit(
             iterations: fit.iterations as u64,
             identifiable: fit.identifiable,
             condition_number: finite(fit.condition_number),
+            fisher_rank: Some(fit.fisher_rank as u64),
             discretisation: fit.discretisation.clone(),
             std_error_basis: fit.std_error_basis.to_owned(),
             crb_at: bound.map(|(_, at)| at),
