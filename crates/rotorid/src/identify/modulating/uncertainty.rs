@@ -82,19 +82,26 @@ impl Overlaps {
         self.lags
     }
 
+    /// Test functions per window.
+    pub(crate) fn functions(&self) -> usize {
+        self.functions
+    }
+
+    /// M(lag hop, i, j): `[a][b]` = sum_k T_i,a(k) T_j,b(k - lag hop), T = (psi, psi',
+    /// psi'') of the early window's function i and the late one's j.
     #[inline]
-    fn get(&self, lag: usize, i: usize, j: usize) -> &[[f64; 3]; 3] {
+    pub(crate) fn get(&self, lag: usize, i: usize, j: usize) -> &[[f64; 3]; 3] {
         &self.m[(lag * self.functions + i) * self.functions + j]
     }
 }
 
-/// A completed window as the covariance needs it.
+/// A completed window as the covariance needs it (P regressors per row).
 #[derive(Debug, Clone)]
-pub(crate) struct ClosedWindow {
+pub(crate) struct ClosedWindow<const P: usize> {
     /// Index of its first sample.
     pub start: u64,
     /// phi of each test function, x rows then z rows.
-    pub phi: [Vec<[f64; 3]>; 2],
+    pub phi: [Vec<[f64; P]>; 2],
     /// w \[rad/s\] at the window's centre.
     pub w: f64,
     /// w' \[rad/s^2\] at the window's centre.
@@ -128,8 +135,8 @@ fn add_outer(acc: &mut [[f64; 3]; 3], c: f64, u: &[f64; 3], v: &[f64; 3], both: 
 pub(crate) fn add_pair(
     meat: &mut [Meat; 2],
     ov: &Overlaps,
-    early: &ClosedWindow,
-    late: &ClosedWindow,
+    early: &ClosedWindow<3>,
+    late: &ClosedWindow<3>,
     lag: usize,
     a: f64,
     two_l: f64,
