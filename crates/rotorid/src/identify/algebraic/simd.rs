@@ -96,6 +96,11 @@ mod imp {
                 F2(_mm_or_pd(_mm_and_pd(gt, yes.0), _mm_andnot_pd(gt, no.0)))
             }
         }
+        /// `self > o` in either lane (false for NaN).
+        #[inline(always)]
+        pub(crate) fn any_gt(self, o: Self) -> bool {
+            unsafe { _mm_movemask_pd(_mm_cmpgt_pd(self.0, o.0)) != 0 }
+        }
     }
 }
 
@@ -180,6 +185,10 @@ mod imp {
             };
             F2([pick(0), pick(1)])
         }
+        #[inline(always)]
+        pub(crate) fn any_gt(self, o: Self) -> bool {
+            self.0[0] > o.0[0] || self.0[1] > o.0[1]
+        }
     }
 }
 
@@ -262,6 +271,7 @@ mod tests {
                 let pick = x.pick_gt(y, F2::splat(1.0), F2::splat(2.0)).to_array();
                 assert_eq!(pick[0], if a > b { 1.0 } else { 2.0 });
                 assert_eq!(pick[1], if b > a { 1.0 } else { 2.0 });
+                assert_eq!(x.any_gt(y), a > b || b > a);
             }
         }
         assert_eq!(F2::new(1.0, 2.0).to_array(), [1.0, 2.0]);

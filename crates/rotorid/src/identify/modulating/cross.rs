@@ -62,6 +62,11 @@
 //!
 //! Memory is bounded as for the Jeffcott identifier: the open windows, the completed
 //! ones they overlap, the tables; nothing grows with the record.
+//!
+//! Measured (docs/method.md section 4.8, tests/it/cross_modulating.rs): exact data to
+//! 5e-9; at 40 dB over 100 seeds unbiased within its standard errors (|mean error /
+//! standard error| <= 0.17), 95 % intervals covering 90-98 % per value, RMS errors 1.1-2.7
+//! times the Cramer-Rao bound.
 
 use std::collections::VecDeque;
 
