@@ -39,10 +39,7 @@ fn worst_at_100ms(rotor: &CrossRotor, with_state: bool) -> ([f64; 10], [f64; 10]
     let t = rotor.truth();
     let (mut own, mut direct) = ([0.0f64; 10], [0.0f64; 10]);
     for (name, speed) in speeds() {
-        let mut case = Case::new(*rotor, speed, 0.1);
-        if with_state {
-            case = case.with_initial_state();
-        }
+        let case = Case::new(*rotor, speed, 0.1).starting(with_state);
         let e = *at(&estimates(rotor, &case.simulate()), 0.1);
         let v = e.values();
         for i in 0..10 {
@@ -140,10 +137,7 @@ fn jeffcott_data_give_zero_cross_terms_and_the_3x3_values() {
     let mut worst = [0.0f64; 10];
     for (name, speed) in speeds() {
         for with_state in [false, true] {
-            let mut case = Case::new(rotor, speed, 0.1);
-            if with_state {
-                case = case.with_initial_state();
-            }
+            let case = Case::new(rotor, speed, 0.1).starting(with_state);
             let resp = case.simulate();
             let cross = *at(&estimates(&rotor, &resp), 0.1);
             let jeff =

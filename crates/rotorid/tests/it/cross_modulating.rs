@@ -39,10 +39,7 @@ fn exact_data_give_every_value_to_1e_8() {
     ] {
         for (name, speed) in speeds() {
             for with_state in [false, true] {
-                let mut case = Case::new(rotor, speed, 0.5);
-                if with_state {
-                    case = case.with_initial_state();
-                }
+                let case = Case::new(rotor, speed, 0.5).starting(with_state);
                 let e = run(&rotor, &case.simulate(), ModulatingConfig::default());
                 let err: Vec<f64> = e
                     .values()
@@ -305,23 +302,26 @@ fn cross_modulating_monte_carlo() {
 fn streaming_is_the_batch_and_bad_input_is_named() {
     let rotor = CrossRotor::cross();
     let resp = Case::new(rotor, Speed::ramp(600.0), 0.2).simulate();
-    let batch = identify_cross_modulating(
-        &resp.t,
-        &resp.x,
-        &resp.z,
-        &resp.phi,
-        &resp.phi_dot,
-        &resp.phi_ddot,
-        rotor.known(),
-        ModulatingConfig::default(),
-    )
-    .unwrap();
+    // the record's first n samples, with x given separately
+    let batch = |n: usize, x: &[f64]| {
+        identify_cross_modulating(
+            &resp.t[..n],
+            x,
+            &resp.z[..n],
+            &resp.phi[..n],
+            &resp.phi_dot[..n],
+            &resp.phi_ddot[..n],
+            rotor.known(),
+            ModulatingConfig::default(),
+        )
+    };
+    let whole = batch(resp.len(), &resp.x).unwrap();
     let mut id =
         CrossModulatingIdentifier::new(rotor.known(), 1e-4, ModulatingConfig::default()).unwrap();
     for i in 0..resp.len() {
         id.push(&measurement(&resp, i)).unwrap();
     }
-    assert_eq!(id.finish().unwrap(), batch);
+    assert_eq!(id.finish().unwrap(), whole);
     // a bad sample is refused with its name and leaves the identifier as it was
     let before = id.estimate();
     let mut bad = measurement(&resp, resp.len() - 1);
@@ -331,17 +331,7 @@ fn streaming_is_the_batch_and_bad_input_is_named() {
     assert!(e.contains("z = inf") && e.contains("2001"), "{e}");
     assert_eq!(id.estimate(), before);
     // too short a record, too short a window: the Jeffcott identifier's errors
-    let short = identify_cross_modulating(
-        &resp.t[..150],
-        &resp.x[..150],
-        &resp.z[..150],
-        &resp.phi[..150],
-        &resp.phi_dot[..150],
-        &resp.phi_ddot[..150],
-        rotor.known(),
-        ModulatingConfig::default(),
-    )
-    .unwrap_err();
+    let short = batch(150, &resp.x[..150]).unwrap_err();
     assert!(
         matches!(
             short,
@@ -362,18 +352,7 @@ fn streaming_is_the_batch_and_bad_input_is_named() {
     );
     let mut unequal = resp.x.clone();
     unequal.pop();
-    let e = identify_cross_modulating(
-        &resp.t,
-        &unequal,
-        &resp.z,
-        &resp.phi,
-        &resp.phi_dot,
-        &resp.phi_ddot,
-        rotor.known(),
-        ModulatingConfig::default(),
-    )
-    .unwrap_err()
-    .to_string();
+    let e = batch(resp.len(), &unequal).unwrap_err().to_string();
     assert!(
         e.contains("column x has 2000 samples but t has 2001"),
         "{e}"

@@ -8,7 +8,7 @@ use super::cross_estimate::CrossAlgebraicEstimate;
 use super::error::AlgebraicError;
 use super::estimate::AlgebraicEstimate;
 use super::identifier::AlgebraicIdentifier;
-use crate::identify::sampling::record_dt;
+use crate::identify::sampling::record_columns_dt;
 use crate::identify::{Known, Measurement};
 use crate::model::SpeedState;
 use crate::simulate::TimeResponse;
@@ -71,14 +71,14 @@ pub fn identify_cross_response(
 
 /// The sampling period of `resp` after checking its columns (see `record_dt`).
 fn response_dt(resp: &TimeResponse) -> Result<f64, AlgebraicError> {
-    Ok(record_dt(
+    Ok(record_columns_dt(
         &resp.t,
         [
-            ("x", resp.x.len()),
-            ("z", resp.z.len()),
-            ("phi", resp.phi.len()),
-            ("phi_dot", resp.phi_dot.len()),
-            ("phi_ddot", resp.phi_ddot.len()),
+            resp.x.len(),
+            resp.z.len(),
+            resp.phi.len(),
+            resp.phi_dot.len(),
+            resp.phi_ddot.len(),
         ],
     )?)
 }

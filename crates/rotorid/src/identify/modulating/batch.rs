@@ -8,7 +8,7 @@ use super::cross_estimate::CrossModulatingEstimate;
 use super::error::ModulatingError;
 use super::estimate::ModulatingEstimate;
 use super::identifier::ModulatingIdentifier;
-use crate::identify::sampling::record_dt;
+use crate::identify::sampling::record_columns_dt;
 use crate::identify::{Known, Measurement};
 use crate::model::SpeedState;
 use crate::simulate::TimeResponse;
@@ -36,11 +36,25 @@ pub fn identify_modulating(
         w,
         w_dot,
     };
-    let dt = record.dt()?;
-    let mut id = ModulatingIdentifier::new(known, dt, config)?;
-    record.check_window(id.window_samples(), id.window_s(), dt)?;
-    record.feed(|m| id.push(m))?;
-    Ok(id.estimate())
+    record.identify::<ModulatingIdentifier>(known, config)
+}
+
+/// [`identify_modulating`] over a simulated record.
+pub fn identify_modulating_response(
+    resp: &TimeResponse,
+    known: Known,
+    config: ModulatingConfig,
+) -> Result<ModulatingEstimate, ModulatingError> {
+    identify_modulating(
+        &resp.t,
+        &resp.x,
+        &resp.z,
+        &resp.phi,
+        &resp.phi_dot,
+        &resp.phi_ddot,
+        known,
+        config,
+    )
 }
 
 /// The cross-coupled identifier ([`CrossModulatingIdentifier`]) over a whole record: m
@@ -65,11 +79,7 @@ pub fn identify_cross_modulating(
         w,
         w_dot,
     };
-    let dt = record.dt()?;
-    let mut id = CrossModulatingIdentifier::new(known, dt, config)?;
-    record.check_window(id.window_samples(), id.window_s(), dt)?;
-    record.feed(|m| id.push(m))?;
-    Ok(id.estimate())
+    record.identify::<CrossModulatingIdentifier>(known, config)
 }
 
 /// [`identify_cross_modulating`] over a simulated record.
@@ -90,6 +100,48 @@ pub fn identify_cross_modulating_response(
     )
 }
 
+/// What a whole record needs of a streaming modulating identifier.
+trait Streaming: Sized {
+    type Estimate;
+    fn build(known: Known, dt: f64, config: ModulatingConfig) -> Result<Self, ModulatingError>;
+    fn push(&mut self, m: &Measurement) -> Result<(), ModulatingError>;
+    fn finish(&self) -> Result<Self::Estimate, ModulatingError>;
+    /// (samples, length \[s\]) of one window.
+    fn window(&self) -> (usize, f64);
+}
+
+impl Streaming for ModulatingIdentifier {
+    type Estimate = ModulatingEstimate;
+    fn build(known: Known, dt: f64, config: ModulatingConfig) -> Result<Self, ModulatingError> {
+        Self::new(known, dt, config)
+    }
+    fn push(&mut self, m: &Measurement) -> Result<(), ModulatingError> {
+        Self::push(self, m)
+    }
+    fn finish(&self) -> Result<Self::Estimate, ModulatingError> {
+        Self::finish(self)
+    }
+    fn window(&self) -> (usize, f64) {
+        (self.window_samples(), self.window_s())
+    }
+}
+
+impl Streaming for CrossModulatingIdentifier {
+    type Estimate = CrossModulatingEstimate;
+    fn build(known: Known, dt: f64, config: ModulatingConfig) -> Result<Self, ModulatingError> {
+        Self::new(known, dt, config)
+    }
+    fn push(&mut self, m: &Measurement) -> Result<(), ModulatingError> {
+        Self::push(self, m)
+    }
+    fn finish(&self) -> Result<Self::Estimate, ModulatingError> {
+        Self::finish(self)
+    }
+    fn window(&self) -> (usize, f64) {
+        (self.window_samples(), self.window_s())
+    }
+}
+
 /// The columns of a record (units in [`identify_modulating`]'s docs).
 struct Columns<'a> {
     t: &'a [f64],
@@ -101,23 +153,25 @@ struct Columns<'a> {
 }
 
 impl Columns<'_> {
-    /// The sampling period, after checking the columns' lengths.
-    fn dt(&self) -> Result<f64, ModulatingError> {
-        Ok(record_dt(
+    /// Check the columns (equal lengths, at least two samples, one whole window), push every
+    /// sample in order, stop at the first error, and give the estimate.
+    fn identify<I: Streaming>(
+        &self,
+        known: Known,
+        config: ModulatingConfig,
+    ) -> Result<I::Estimate, ModulatingError> {
+        let dt = record_columns_dt(
             self.t,
             [
-                ("x", self.x.len()),
-                ("z", self.z.len()),
-                ("phi", self.phi.len()),
-                ("phi_dot", self.w.len()),
-                ("phi_ddot", self.w_dot.len()),
+                self.x.len(),
+                self.z.len(),
+                self.phi.len(),
+                self.w.len(),
+                self.w_dot.len(),
             ],
-        )?)
-    }
-
-    /// [`ModulatingError::RecordShorterThanWindow`] unless one window of `needed` samples
-    /// (`window_s` \[s\] at `dt` \[s\]) fits.
-    fn check_window(&self, needed: usize, window_s: f64, dt: f64) -> Result<(), ModulatingError> {
+        )?;
+        let mut id = I::build(known, dt, config)?;
+        let (needed, window_s) = id.window();
         let samples = self.t.len();
         if samples < needed {
             return Err(ModulatingError::RecordShorterThanWindow {
@@ -127,16 +181,8 @@ impl Columns<'_> {
                 dt,
             });
         }
-        Ok(())
-    }
-
-    /// Push every sample, in order, until the first error.
-    fn feed(
-        &self,
-        mut push: impl FnMut(&Measurement) -> Result<(), ModulatingError>,
-    ) -> Result<(), ModulatingError> {
-        for i in 0..self.t.len() {
-            push(&Measurement {
+        for i in 0..samples {
+            id.push(&Measurement {
                 t: self.t[i],
                 x: self.x[i],
                 z: self.z[i],
@@ -147,24 +193,6 @@ impl Columns<'_> {
                 },
             })?;
         }
-        Ok(())
+        id.finish()
     }
-}
-
-/// [`identify_modulating`] over a simulated record.
-pub fn identify_modulating_response(
-    resp: &TimeResponse,
-    known: Known,
-    config: ModulatingConfig,
-) -> Result<ModulatingEstimate, ModulatingError> {
-    identify_modulating(
-        &resp.t,
-        &resp.x,
-        &resp.z,
-        &resp.phi,
-        &resp.phi_dot,
-        &resp.phi_ddot,
-        known,
-        config,
-    )
 }

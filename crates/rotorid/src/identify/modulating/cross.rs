@@ -76,7 +76,7 @@ use super::cross_uncertainty::{add_cross_pair, CrossMeat};
 use super::error::ModulatingError;
 use super::normal_equations::Gram;
 use super::stream::{setup, OpenWindow, WindowStream};
-use super::uncertainty::{ClosedWindow, Overlaps};
+use super::uncertainty::{pair_overlapping, ClosedWindow, Overlaps};
 use crate::identify::{Known, Measurement};
 
 /// Unknowns per row.
@@ -88,7 +88,6 @@ pub(crate) const P5: usize = 5;
 #[derive(Debug, Clone)]
 pub struct CrossModulatingIdentifier {
     known: Known,
-    dt: f64,
     config: ModulatingConfig,
     stream: WindowStream<true>,
     overlaps: Overlaps,
@@ -114,9 +113,8 @@ impl CrossModulatingIdentifier {
         let s = setup(known, dt, config)?;
         Ok(Self {
             known: s.known,
-            dt: s.dt,
             config: s.config,
-            stream: WindowStream::new(s.tf, s.hop),
+            stream: WindowStream::new(s.dt, s.tf, s.hop),
             overlaps: s.overlaps,
             closed: VecDeque::new(),
             gram: [Gram::default(); 2],
@@ -133,17 +131,17 @@ impl CrossModulatingIdentifier {
 
     /// The window length used, L = whole sampling intervals * dt \[s\].
     pub fn window_s(&self) -> f64 {
-        self.stream.tf.intervals() as f64 * self.dt
+        self.stream.window_s()
     }
 
     /// The hop used \[s\].
     pub fn hop_s(&self) -> f64 {
-        self.stream.hop as f64 * self.dt
+        self.stream.hop_s()
     }
 
     /// Samples in one window (intervals + 1).
     pub fn window_samples(&self) -> usize {
-        self.stream.tf.intervals() + 1
+        self.stream.window_samples()
     }
 
     /// Samples accepted so far.
@@ -158,14 +156,14 @@ impl CrossModulatingIdentifier {
 
     /// 2 / L \[1/s\].
     fn two_l(&self) -> f64 {
-        2.0 / self.stream.tf.intervals() as f64 / self.dt
+        self.stream.two_l()
     }
 
     /// Take the next measurement. Errors (the identifier is left unchanged, so the
     /// caller may skip the sample): a non-finite field, or a time that is not the previous
     /// one plus dt within `1e-6 dt + 8 ulp(t)`.
     pub fn push(&mut self, m: &Measurement) -> Result<(), ModulatingError> {
-        self.stream.validate(m, self.dt)?;
+        self.stream.validate(m)?;
         self.stream.accumulate(m, self.known.alpha);
         while let Some(win) = self.stream.pop_complete(m.t) {
             self.close(&win);
@@ -198,22 +196,17 @@ impl CrossModulatingIdentifier {
         for (tot, v) in self.noise_sums.iter_mut().zip(win.noise) {
             *tot += v;
         }
-        let reach = self.stream.tf.intervals() as u64;
-        while self
-            .closed
-            .front()
-            .is_some_and(|c| done.start - c.start > reach)
-        {
-            self.closed.pop_front();
-        }
-        for early in &self.closed {
-            let lag = ((done.start - early.start) / self.stream.hop) as usize;
-            if lag < self.overlaps.lags() {
-                add_cross_pair(&mut self.meat, &self.overlaps, early, &done, lag, a, two_l);
-            }
-        }
-        add_cross_pair(&mut self.meat, &self.overlaps, &done, &done, 0, a, two_l);
-        self.closed.push_back(done);
+        // pairs with the earlier windows that overlap this one, and with itself
+        let meat = &mut self.meat;
+        let overlaps = &self.overlaps;
+        pair_overlapping(
+            &mut self.closed,
+            done,
+            self.stream.tf.intervals() as u64,
+            self.stream.hop,
+            overlaps.lags(),
+            |early, late, lag| add_cross_pair(meat, overlaps, early, late, lag, a, two_l),
+        );
         self.windows += 1;
     }
 
@@ -221,12 +214,7 @@ impl CrossModulatingIdentifier {
     /// the standard errors: the given ones for [`NoiseCompensation::Known`], else the
     /// fourth-difference estimate (0 before five samples).
     pub fn noise_sigmas(&self) -> (f64, f64) {
-        match self.config.noise {
-            NoiseCompensation::Known { sigma_x, sigma_z } => (sigma_x, sigma_z),
-            NoiseCompensation::None | NoiseCompensation::Estimated => {
-                self.stream.estimated_sigmas()
-            }
-        }
+        self.stream.noise_sigmas(self.config.noise)
     }
 
     /// The noise terms subtracted from row `row`'s Gram for noise variances `var` =
@@ -319,14 +307,7 @@ impl CrossModulatingIdentifier {
     /// The estimate once every sample is in: [`Self::estimate`], or
     /// [`ModulatingError::RecordShorterThanWindow`] when not one window was completed.
     pub fn finish(&self) -> Result<CrossModulatingEstimate, ModulatingError> {
-        if self.windows == 0 {
-            return Err(ModulatingError::RecordShorterThanWindow {
-                samples: self.samples() as usize,
-                needed: self.window_samples(),
-                window_s: self.window_s(),
-                dt: self.dt,
-            });
-        }
+        self.stream.require_window(self.windows)?;
         Ok(self.estimate())
     }
 
@@ -440,6 +421,15 @@ mod tests {
         }
     }
 
+    /// An identifier fed every measurement of `data`.
+    fn fed(data: &[Measurement], config: ModulatingConfig) -> CrossModulatingIdentifier {
+        let mut id = CrossModulatingIdentifier::new(KNOWN, DT, config).unwrap();
+        for m in data {
+            id.push(m).unwrap();
+        }
+        id
+    }
+
     fn close(a: f64, b: f64, scale: f64) -> bool {
         (a - b).abs() <= 1e-11 * scale
     }
@@ -447,11 +437,7 @@ mod tests {
     #[test]
     fn compensation_is_the_expected_noise_part_of_the_gram_sample_by_sample() {
         let data = record(700);
-        let mut id =
-            CrossModulatingIdentifier::new(KNOWN, DT, ModulatingConfig::default()).unwrap();
-        for m in &data {
-            id.push(m).unwrap();
-        }
+        let id = fed(&data, ModulatingConfig::default());
         let tf = &id.stream.tf;
         let windows = brute_rows(&id, &data);
         assert_eq!(windows.len() as u64, id.windows());
@@ -509,10 +495,7 @@ mod tests {
             },
             ..ModulatingConfig::default()
         };
-        let mut id = CrossModulatingIdentifier::new(KNOWN, DT, config).unwrap();
-        for m in &data {
-            id.push(m).unwrap();
-        }
+        let id = fed(&data, config);
         let e = id.finish().unwrap();
         let windows = brute_rows(&id, &data);
         let half_l = 0.5 * id.window_s();
@@ -550,11 +533,7 @@ mod tests {
         // (w, w' at the window's centre): a per-sample sum, where the identifier pairs
         // overlapping windows through lag tables.
         let data = record(800);
-        let mut id =
-            CrossModulatingIdentifier::new(KNOWN, DT, ModulatingConfig::default()).unwrap();
-        for m in &data {
-            id.push(m).unwrap();
-        }
+        let id = fed(&data, ModulatingConfig::default());
         let tf = &id.stream.tf;
         let windows = brute_rows(&id, &data);
         let theta = [1.3, -0.7, 0.4, 2.1, -1.5];

@@ -32,7 +32,7 @@ use super::error::ModulatingError;
 use super::estimate::{ModulatingDirection, ModulatingEstimate};
 use super::normal_equations::Gram;
 use super::stream::{setup, OpenWindow, WindowStream};
-use super::uncertainty::{add_pair, ClosedWindow, Meat, Overlaps};
+use super::uncertainty::{add_pair, pair_overlapping, ClosedWindow, Meat, Overlaps};
 use crate::identify::{Known, Measurement};
 
 /// The streaming modulating-function identifier (module docs of `modulating`). Feed it
@@ -41,7 +41,6 @@ use crate::identify::{Known, Measurement};
 #[derive(Debug, Clone)]
 pub struct ModulatingIdentifier {
     known: Known,
-    dt: f64,
     config: ModulatingConfig,
     stream: WindowStream<false>,
     /// Completed windows that the next ones may overlap.
@@ -64,9 +63,8 @@ impl ModulatingIdentifier {
         let s = setup(known, dt, config)?;
         Ok(Self {
             known: s.known,
-            dt: s.dt,
             config: s.config,
-            stream: WindowStream::new(s.tf, s.hop),
+            stream: WindowStream::new(s.dt, s.tf, s.hop),
             closed: VecDeque::new(),
             overlaps: s.overlaps,
             gram: [Gram::default(); 2],
@@ -82,17 +80,17 @@ impl ModulatingIdentifier {
 
     /// The window length used, L = whole sampling intervals * dt \[s\].
     pub fn window_s(&self) -> f64 {
-        self.stream.tf.intervals() as f64 * self.dt
+        self.stream.window_s()
     }
 
     /// The hop used \[s\].
     pub fn hop_s(&self) -> f64 {
-        self.stream.hop as f64 * self.dt
+        self.stream.hop_s()
     }
 
     /// Samples in one window (intervals + 1).
     pub fn window_samples(&self) -> usize {
-        self.stream.tf.intervals() + 1
+        self.stream.window_samples()
     }
 
     /// Samples accepted so far.
@@ -109,7 +107,7 @@ impl ModulatingIdentifier {
     /// caller may skip the sample): a non-finite field, or a time that is not the previous
     /// one plus dt within `1e-6 dt + 8 ulp(t)`.
     pub fn push(&mut self, m: &Measurement) -> Result<(), ModulatingError> {
-        self.stream.validate(m, self.dt)?;
+        self.stream.validate(m)?;
         self.stream.accumulate(m, self.known.alpha);
         while let Some(win) = self.stream.pop_complete(m.t) {
             self.close(&win);
@@ -121,7 +119,7 @@ impl ModulatingIdentifier {
     /// Add the rows of a completed window to the normal equations and its pairs with the
     /// completed windows it overlaps to the covariance sums.
     fn close(&mut self, win: &OpenWindow) {
-        let two_l = 2.0 / self.stream.tf.intervals() as f64 / self.dt;
+        let two_l = self.stream.two_l();
         let (a, mud) = (self.known.a, self.known.mud);
         let f = self.stream.tf.functions();
         let mut done = ClosedWindow {
@@ -138,22 +136,16 @@ impl ModulatingIdentifier {
             done.phi[1].push(pz);
         }
         // pairs with the earlier windows that overlap this one, and with itself
-        let reach = self.stream.tf.intervals() as u64;
-        while self
-            .closed
-            .front()
-            .is_some_and(|c| done.start - c.start > reach)
-        {
-            self.closed.pop_front();
-        }
-        for early in &self.closed {
-            let lag = ((done.start - early.start) / self.stream.hop) as usize;
-            if lag < self.overlaps.lags() {
-                add_pair(&mut self.meat, &self.overlaps, early, &done, lag, a, two_l);
-            }
-        }
-        add_pair(&mut self.meat, &self.overlaps, &done, &done, 0, a, two_l);
-        self.closed.push_back(done);
+        let meat = &mut self.meat;
+        let overlaps = &self.overlaps;
+        pair_overlapping(
+            &mut self.closed,
+            done,
+            self.stream.tf.intervals() as u64,
+            self.stream.hop,
+            overlaps.lags(),
+            |early, late, lag| add_pair(meat, overlaps, early, late, lag, a, two_l),
+        );
         self.windows += 1;
     }
 
@@ -161,12 +153,7 @@ impl ModulatingIdentifier {
     /// errors: the given ones for [`NoiseCompensation::Known`], else the fourth-difference
     /// estimate (0 before five samples).
     pub fn noise_sigmas(&self) -> (f64, f64) {
-        match self.config.noise {
-            NoiseCompensation::Known { sigma_x, sigma_z } => (sigma_x, sigma_z),
-            NoiseCompensation::None | NoiseCompensation::Estimated => {
-                self.stream.estimated_sigmas()
-            }
-        }
+        self.stream.noise_sigmas(self.config.noise)
     }
 
     /// The least-squares estimate from every window completed so far (singular, NaN, with
@@ -234,14 +221,7 @@ impl ModulatingIdentifier {
     /// The estimate once every sample is in: [`Self::estimate`], or
     /// [`ModulatingError::RecordShorterThanWindow`] when not one window was completed.
     pub fn finish(&self) -> Result<ModulatingEstimate, ModulatingError> {
-        if self.windows == 0 {
-            return Err(ModulatingError::RecordShorterThanWindow {
-                samples: self.samples() as usize,
-                needed: self.window_samples(),
-                window_s: self.window_s(),
-                dt: self.dt,
-            });
-        }
+        self.stream.require_window(self.windows)?;
         Ok(self.estimate())
     }
 

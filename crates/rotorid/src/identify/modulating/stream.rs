@@ -18,7 +18,7 @@
 
 use std::collections::VecDeque;
 
-use super::config::ModulatingConfig;
+use super::config::{ModulatingConfig, NoiseCompensation};
 use super::error::ModulatingError;
 use super::noise_estimate::DifferenceNoise;
 use super::test_functions::TestFunctions;
@@ -111,6 +111,8 @@ pub(crate) struct OpenWindow {
 /// The window machinery shared by the modulating identifiers (module docs).
 #[derive(Debug, Clone)]
 pub(crate) struct WindowStream<const NOISE_SUMS: bool> {
+    /// The sampling period \[s\].
+    pub dt: f64,
     pub tf: TestFunctions,
     /// Hop in samples.
     pub hop: u64,
@@ -126,7 +128,8 @@ pub(crate) struct WindowStream<const NOISE_SUMS: bool> {
 }
 
 impl<const NOISE_SUMS: bool> WindowStream<NOISE_SUMS> {
-    pub(crate) fn new(tf: TestFunctions, hop: u64) -> Self {
+    /// The stream of windows of `tf` every `hop` samples of period `dt` \[s\].
+    pub(crate) fn new(dt: f64, tf: TestFunctions, hop: u64) -> Self {
         let squares = if NOISE_SUMS {
             (0..=tf.intervals())
                 .map(|k| {
@@ -139,6 +142,7 @@ impl<const NOISE_SUMS: bool> WindowStream<NOISE_SUMS> {
             Vec::new()
         };
         Self {
+            dt,
             tf,
             hop,
             open: VecDeque::new(),
@@ -150,8 +154,43 @@ impl<const NOISE_SUMS: bool> WindowStream<NOISE_SUMS> {
         }
     }
 
-    /// Check the next measurement: every field finite, on the uniform grid of period `dt`.
-    pub(crate) fn validate(&self, m: &Measurement, dt: f64) -> Result<(), InputError> {
+    /// The window length, L = whole sampling intervals * dt \[s\].
+    pub(crate) fn window_s(&self) -> f64 {
+        self.tf.intervals() as f64 * self.dt
+    }
+
+    /// 2 / L \[1/s\].
+    pub(crate) fn two_l(&self) -> f64 {
+        2.0 / self.tf.intervals() as f64 / self.dt
+    }
+
+    /// The hop \[s\].
+    pub(crate) fn hop_s(&self) -> f64 {
+        self.hop as f64 * self.dt
+    }
+
+    /// Samples in one window (intervals + 1).
+    pub(crate) fn window_samples(&self) -> usize {
+        self.tf.intervals() + 1
+    }
+
+    /// [`ModulatingError::RecordShorterThanWindow`] when not one of the `windows` has
+    /// completed.
+    pub(crate) fn require_window(&self, windows: u64) -> Result<(), ModulatingError> {
+        if windows == 0 {
+            return Err(ModulatingError::RecordShorterThanWindow {
+                samples: self.n as usize,
+                needed: self.window_samples(),
+                window_s: self.window_s(),
+                dt: self.dt,
+            });
+        }
+        Ok(())
+    }
+
+    /// Check the next measurement: every field finite, on the uniform grid.
+    pub(crate) fn validate(&self, m: &Measurement) -> Result<(), InputError> {
+        let dt = self.dt;
         let s = &m.speed;
         let fields = [
             ("t", m.t),
@@ -249,8 +288,13 @@ impl<const NOISE_SUMS: bool> WindowStream<NOISE_SUMS> {
         self.t_prev = m.t;
     }
 
-    /// (sigma_x, sigma_z) from the fourth differences so far \[m\] (0 before five samples).
-    pub(crate) fn estimated_sigmas(&self) -> (f64, f64) {
+    /// The noise standard deviations (sigma_x, sigma_z) \[m\] under `noise`: the given
+    /// ones for [`NoiseCompensation::Known`], else the fourth-difference estimate so far (0
+    /// before five samples).
+    pub(crate) fn noise_sigmas(&self, noise: NoiseCompensation) -> (f64, f64) {
+        if let NoiseCompensation::Known { sigma_x, sigma_z } = noise {
+            return (sigma_x, sigma_z);
+        }
         let s = |d: &DifferenceNoise| {
             let v = d.sigma();
             if v.is_finite() {

@@ -33,6 +33,8 @@
 //! (noisy) phi_r stand in for the noise-free ones, and terms of order sigma^4 are
 //! neglected: the standard errors are asymptotic (first order), like the CRB.
 
+use std::collections::VecDeque;
+
 use super::test_functions::TestFunctions;
 
 /// Column of the table (psi, psi', psi'') and sign for each unknown (m, c, k): the row is
@@ -106,6 +108,31 @@ pub(crate) struct ClosedWindow<const P: usize> {
     pub w: f64,
     /// w' \[rad/s^2\] at the window's centre.
     pub w_dot: f64,
+}
+
+/// Pair the window `done`, just completed, with the completed windows it overlaps: drop
+/// from `closed` those it no longer reaches (starts more than `reach` samples apart), call
+/// `add(early, &done, lag)` for each one within the `lags` tabulated (lag in hops of `hop`
+/// samples), then `add(&done, &done, 0)`, and keep `done` for the windows to come.
+pub(crate) fn pair_overlapping<const P: usize>(
+    closed: &mut VecDeque<ClosedWindow<P>>,
+    done: ClosedWindow<P>,
+    reach: u64,
+    hop: u64,
+    lags: usize,
+    mut add: impl FnMut(&ClosedWindow<P>, &ClosedWindow<P>, usize),
+) {
+    while closed.front().is_some_and(|c| done.start - c.start > reach) {
+        closed.pop_front();
+    }
+    for early in closed.iter() {
+        let lag = ((done.start - early.start) / hop) as usize;
+        if lag < lags {
+            add(early, &done, lag);
+        }
+    }
+    add(&done, &done, 0);
+    closed.push_back(done);
 }
 
 /// The theta-free parts of V for one direction (module docs).

@@ -273,6 +273,15 @@ impl Case {
         }
     }
 
+    /// [`Case::with_initial_state`] when `moving`, else the case as it is (from rest).
+    pub fn starting(self, moving: bool) -> Self {
+        if moving {
+            self.with_initial_state()
+        } else {
+            self
+        }
+    }
+
     pub fn samples(&self) -> usize {
         (self.duration / self.dt * (1.0 + 1e-9)).floor() as usize + 1
     }
