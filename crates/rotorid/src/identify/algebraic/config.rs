@@ -34,7 +34,7 @@ pub const DEFAULT_ALGEBRAIC_RCOND_MIN: f64 = 1e-5;
 /// within 1e-3 of the truth (cross terms against the direct coefficient of their row). Far
 /// more instants are flagged than for the 3x3 system (12-30 % on table1, up to 83 % on a
 /// well-damped cross-coupled rotor at constant speed): once the free transient has died
-/// out, a single-frequency response cannot separate m from the stiffness (P[y] = -W^2 R[y]
+/// out, a single-frequency response cannot separate m from the stiffness (P\[y\] = -W^2 R\[y\]
 /// for a sinusoid of frequency W) nor the five coefficients of a row, and the 5x5 system
 /// says so. Data errors raise an instant's error to ~(data error)/rcond, as for the 3x3.
 pub const DEFAULT_CROSS_ALGEBRAIC_RCOND_MIN: f64 = DEFAULT_ALGEBRAIC_RCOND_MIN;

@@ -33,7 +33,7 @@
 //! and of a common scale of the signal; a singular or non-finite system gives theta = NaN
 //! and rcond = 0, never a panic.
 //!
-//! The x and z systems are solved together, one per lane of [`F2`]; pivoting is done lane
+//! The x and z systems are solved together, one per lane of a two-lane vector (`simd`); pivoting is done lane
 //! by lane: for column k, each row i > k in turn swaps with row k in the lanes where
 //! |a_ik| > |a_kk| (a blend of the two rows, skipped when no lane needs it), which leaves
 //! the largest candidate of each lane on the diagonal (the order of the other rows differs

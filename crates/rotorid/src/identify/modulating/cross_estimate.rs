@@ -66,7 +66,7 @@ fn ten(x: &[f64; 5], z: &[f64; 5]) -> [f64; 10] {
 
 impl CrossModulatingEstimate {
     /// The ten values in the order m_x, cxx, cxz, kxx, kxz, m_z, czx, czz, kzx, kzz
-    /// ([`crate::identify::algebraic::CROSS_NAMES`]).
+    /// ([`crate::identify::CROSS_NAMES`]).
     pub fn values(&self) -> [f64; 10] {
         ten(&self.x.values, &self.z.values)
     }
