@@ -1,12 +1,16 @@
 //! The rotorid library against independent references (one test binary:
 //! `cargo test -p rotorid --test it`).
 
+mod cross_common;
 mod identify_common;
 
 mod acquisition;
 mod adequacy;
 mod algebraic_windows;
 mod analysis;
+mod cross_algebraic;
+mod cross_modulating;
+mod cross_reference;
 mod identify_accuracy;
 mod identify_conditioning;
 mod identify_convergence;
