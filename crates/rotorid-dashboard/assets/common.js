@@ -1,6 +1,6 @@
 // rotorid dashboard: helpers shared by the pages. Every text that comes from the bus
 // (ids, parameter names, units, messages) goes into the page through textContent or
-// setAttribute, never through innerHTML.
+// setAttribute, never parsed as HTML.
 'use strict';
 
 const R = {};

@@ -474,7 +474,8 @@ impl FleetState {
                 cells[c] = (v.unwrap_or(f64::NAN), se.unwrap_or(f64::NAN));
             }
         }
-        m.results_seen += 1;
+        // sequence 0: read from ROTORID_LATEST at start, counted when its stream copy comes
+        m.results_seen += u64::from(seq > 0);
         m.last_arrival_ms = Some(m.last_arrival_ms.map_or(arrived_ms, |t| t.max(arrived_ms)));
         let point = Point {
             window: r.window,
