@@ -48,7 +48,7 @@ R.plain = function (v, digits) {
   const a = Math.abs(v);
   if (a !== 0 && (a >= 1e9 || a < 1e-3)) {
     const x = Math.floor(Math.log10(a));
-    return (v / Math.pow(10, x)).toFixed(digits - 1) + '\u00d710' + R.sup(x);
+    return Number((v / Math.pow(10, x)).toPrecision(digits)).toString() + '\u00d710' + R.sup(x);
   }
   return R.group(Number(v.toPrecision(digits)).toString());
 };

@@ -40,7 +40,6 @@ function renderMeta(entry) {
     meta.textContent = 'no result yet' + (t.raw_window !== null ? ' (raw window ' + t.raw_window + ' published)' : '');
   } else {
     const parts = ['window ' + t.window, 't0 ' + R.plain(t.t0_s) + ' s', R.ago(t.arrived_ms)];
-    if (t.method) parts.push(t.method);
     if (t.raw_window !== null && t.raw_window > t.window + 1) parts.push((t.raw_window - t.window) + ' windows behind');
     meta.textContent = parts.join(' \u00b7 ');
   }

@@ -55,18 +55,17 @@ function headerRender() {
   if (t.window !== null) parts.push('window ' + t.window, 't0 ' + R.plain(t.t0_s) + ' s', 'stored ' + R.ago(t.arrived_ms));
   else parts.push('no result yet');
   if (t.method) parts.push(t.method);
-  if (t.window_s) parts.push(R.plain(t.window_s) + ' s windows');
-  parts.push(t.results + ' results, ' + t.errors + ' without, ' + t.alerts + ' alerts read');
+  if (t.window_s) parts.push(Number(t.window_s.toPrecision(3)) + ' s windows');
   document.getElementById('meta').textContent = parts.join(' \u00b7 ');
 }
 
 function trendsRender() {
   const box = document.getElementById('trends');
   const pts = sorted(S.windows);
-  const xs = pts.map((p) => p.t0_s);
+  const xs = pts.map((p) => p.window);
   const frag = document.createDocumentFragment();
   const n = S.parameters.length;
-  const h = n > 6 ? 150 : n > 4 ? 170 : 200;
+  const h = n > 6 ? 118 : n > 4 ? 132 : 170;
   S.parameters.forEach((c, i) => {
     const y = pts.map((p) => (p.values[i] === undefined ? null : p.values[i]));
     const se = pts.map((p) => (p.std_errors[i] === undefined ? null : p.std_errors[i]));
@@ -74,22 +73,24 @@ function trendsRender() {
     const hi = y.map((v, k) => (v !== null && se[k] !== null ? v + Z95 * se[k] : null));
     const b = S.baseline.find((q) => q.name === c.name);
     const hband = b && b.value !== null && b.std_error !== null ? { lo: b.value - Z95 * b.std_error, hi: b.value + Z95 * b.std_error } : null;
-    const vmarks = S.alerts.map((a) => ({
-      x: a.t0_s,
-      cls: a.parameter === c.name ? '' : 'other',
+    const vmarks = S.alerts.filter((a) => a.parameter === c.name).map((a) => ({
+      x: a.window,
+      cls: '',
       title: 'alert window ' + a.window + ': ' + a.parameter + ' z = ' + a.z.toFixed(1),
     }));
     const last = y.length ? y[y.length - 1] : null;
     const lastTxt = last === null ? 'withheld' : R.fmt(last, se[se.length - 1]) + ' ' + c.unit;
     const svg = P.chart({
-      w: 900,
+      w: 1000,
       h,
       title: c.name + ' [' + c.unit + ']   newest ' + lastTxt + (b && b.value !== null ? '   baseline ' + R.fmt(b.value, b.std_error) : ''),
       ylabel: c.name + ' [' + c.unit + ']',
-      xlabel: 'window t0 [s]',
+      xlabel: 'window',
       series: [{ x: xs, y, lo, hi }],
       hband,
       vmarks,
+      robust: true,
+      keep: last === null ? [] : [last],
       empty: 'no value of ' + c.name + ' yet',
     });
     svg.dataset.param = c.name;
@@ -115,12 +116,12 @@ function orbitRender() {
   note.hidden = !o.note;
   note.textContent = o.note || '';
   const t = o.x_um.map((_, i) => o.t0_s + i * o.stride * o.dt_s);
-  R.clear(document.getElementById('orbit')).appendChild(P.orbit(o.x_um, o.z_um, o.keyphasor, 420));
+  R.clear(document.getElementById('orbit')).appendChild(P.orbit(o.x_um, o.z_um, o.keyphasor, 400));
   const kpMarks = o.keyphasor.map((k) => ({ x: k.t_s, cls: 'kp-t' }));
   for (const [id, ys, cls, name] of [['xt', o.x_um, '', 'x'], ['zt', o.z_um, 'z', 'z']]) {
     const svg = P.chart({
       w: 560,
-      h: 130,
+      h: 150,
       ylabel: name + ' [\u00b5m]',
       xlabel: 't [s]',
       series: [{ x: t, y: ys, cls, dots: false }],
@@ -134,7 +135,7 @@ function orbitRender() {
 
 function oneXRender() {
   const pts = sorted(S.oneX);
-  const xs = pts.map((p) => p.t0_s);
+  const xs = pts.map((p) => p.window);
   const series = (key, what) => ['x', 'z'].map((d) => {
     const v = pts.map((p) => (p[d] ? p[d][key] : null));
     const se = pts.map((p) => (p[d] ? p[d][what] : null));
@@ -146,9 +147,9 @@ function oneXRender() {
       cls: d === 'z' ? 'z' : '',
     };
   });
-  const amp = P.chart({ w: 620, h: 170, ylabel: 'amplitude [\u00b5m pk]', xlabel: 'window t0 [s]', series: series('amplitude_um', 'amplitude_se_um'), empty: 'no 1X vector yet (needs the phi channel)' });
+  const amp = P.chart({ w: 620, h: 150, ylabel: 'amplitude [\u00b5m pk]', xlabel: 'window', series: series('amplitude_um', 'amplitude_se_um'), robust: true, empty: 'no 1X vector yet (needs the phi channel)' });
   amp.dataset.kind = 'amplitude';
-  const ph = P.chart({ w: 620, h: 170, ylabel: 'phase lag [deg]', xlabel: 'window t0 [s]', series: series('phase_deg', 'phase_se_deg'), empty: 'no 1X vector yet (needs the phi channel)' });
+  const ph = P.chart({ w: 620, h: 150, ylabel: 'phase lag [deg]', xlabel: 'window', series: series('phase_deg', 'phase_se_deg'), empty: 'no 1X vector yet (needs the phi channel)' });
   ph.dataset.kind = 'phase';
   R.clear(document.getElementById('amp')).appendChild(amp);
   R.clear(document.getElementById('phase')).appendChild(ph);

@@ -47,11 +47,12 @@ P.extent = function (values, pad) {
 };
 
 // the "M x y L x y ..." path of the finite points, broken at gaps
-function linePath(xs, ys, sx, sy) {
+function linePath(xs, ys, sx, sy, yd) {
   let d = '';
   let pen = false;
   for (let i = 0; i < xs.length; i++) {
-    const y = ys[i];
+    let y = ys[i];
+    if (yd && y !== null && isFinite(y)) y = Math.min(yd[1], Math.max(yd[0], y));
     if (y === null || !isFinite(y)) { pen = false; continue; }
     d += (pen ? 'L' : 'M') + sx(xs[i]).toFixed(1) + ' ' + sy(y).toFixed(1);
     pen = true;
@@ -59,18 +60,47 @@ function linePath(xs, ys, sx, sy) {
   return d;
 }
 
-// one dot per finite point: "M x y h0" with a round line cap
-function dotPath(xs, ys, sx, sy) {
+// one dot per finite point: "M x y h0" with a round line cap; values outside the y domain
+// are drawn on its edge (and listed, to be marked as off scale)
+function dotPath(xs, ys, sx, sy, yd) {
   let d = '';
   let n = 0;
+  let off = '';
   for (let i = 0; i < xs.length; i++) {
-    const y = ys[i];
+    let y = ys[i];
     if (y === null || !isFinite(y)) continue;
+    const out = yd && (y < yd[0] || y > yd[1]);
+    if (out) {
+      const top = y > yd[1];
+      y = top ? yd[1] : yd[0];
+      const px = sx(xs[i]);
+      const py = sy(y);
+      // a chevron pointing off the scale
+      off += 'M' + (px - 4).toFixed(1) + ' ' + (py + (top ? 7 : -7)).toFixed(1) + 'L' + px.toFixed(1) + ' ' + (py + (top ? 2 : -2)).toFixed(1) +
+        'L' + (px + 4).toFixed(1) + ' ' + (py + (top ? 7 : -7)).toFixed(1);
+    }
     d += 'M' + sx(xs[i]).toFixed(1) + ' ' + sy(y).toFixed(1) + 'h0';
     n++;
   }
-  return { d, n };
+  return { d, n, off };
 }
+
+// a y domain that the typical values fill: from the 5th to the 95th percentile of the
+// values, with the bands of `keep` (the baseline, the newest value), unless every value is
+// within twice that span anyway (then all of them)
+P.robust = function (values, keep) {
+  const v = values.filter((x) => x !== null && isFinite(x)).sort((a, b) => a - b);
+  if (v.length === 0) return P.extent(keep, 0.1);
+  const q = (p) => v[Math.min(v.length - 1, Math.max(0, Math.round(p * (v.length - 1))))];
+  let lo = q(0.05);
+  let hi = q(0.95);
+  for (const k of keep) if (k !== null && isFinite(k)) { lo = Math.min(lo, k); hi = Math.max(hi, k); }
+  const span = hi - lo || Math.abs(hi) * 1e-3 || 1;
+  if (v[0] >= lo - 2 * span && v[v.length - 1] <= hi + 2 * span) {
+    return P.extent(v.concat(keep), 0.08);
+  }
+  return [lo - 0.25 * span, hi + 0.25 * span];
+};
 
 // the band between lo[i] and hi[i], one closed polygon per run of finite points
 function bandPath(xs, lo, hi, sx, sy) {
@@ -113,7 +143,12 @@ P.chart = function (opts) {
   }
   if (opts.hband) ys.push(opts.hband.lo, opts.hband.hi);
   const xd = opts.xdomain || P.extent(xs, 0.02);
-  const yd = opts.ydomain || P.extent(ys, 0.08);
+  let yd = opts.ydomain || P.extent(ys, 0.08);
+  if (opts.robust && !opts.ydomain) {
+    let values = [];
+    for (const s of opts.series) values = values.concat(s.y);
+    yd = P.robust(values, (opts.keep || []).concat(opts.hband ? [opts.hband.lo, opts.hband.hi] : []));
+  }
   if (!xd || !yd) {
     svg.appendChild(P.svg('text', { x: w / 2, y: h / 2, 'text-anchor': 'middle', class: 'empty-msg' }, opts.empty || 'no data yet'));
     return svg;
@@ -121,7 +156,7 @@ P.chart = function (opts) {
   const sx = (v) => m.l + ((v - xd[0]) / (xd[1] - xd[0])) * (w - m.l - m.r);
   const sy = (v) => h - m.b - ((v - yd[0]) / (yd[1] - yd[0])) * (h - m.t - m.b);
   const gx = P.ticks(xd[0], xd[1], Math.max(2, Math.floor((w - m.l) / 110)));
-  const gy = P.ticks(yd[0], yd[1], Math.max(2, Math.floor((h - m.t - m.b) / 34)));
+  const gy = P.ticks(yd[0], yd[1], Math.max(3, Math.floor((h - m.t - m.b) / 30)));
   for (const v of gy.ticks) {
     if (v < yd[0] || v > yd[1]) continue;
     svg.appendChild(P.svg('line', { x1: m.l, x2: w - m.r, y1: sy(v), y2: sy(v), class: 'grid' }));
@@ -157,10 +192,15 @@ P.chart = function (opts) {
     g.appendChild(l);
   }
   for (const s of opts.series) {
-    g.appendChild(P.svg('path', { d: linePath(s.x, s.y, sx, sy), class: 'series ' + (s.cls || '') }));
+    g.appendChild(P.svg('path', { d: linePath(s.x, s.y, sx, sy, yd), class: 'series ' + (s.cls || '') }));
     if (s.dots !== false) {
-      const dp = dotPath(s.x, s.y, sx, sy);
+      const dp = dotPath(s.x, s.y, sx, sy, yd);
       g.appendChild(P.svg('path', { d: dp.d, class: 'dots ' + (s.cls || ''), 'data-points': dp.n }));
+      if (dp.off) {
+        const o = P.svg('path', { d: dp.off, class: 'offscale' });
+        o.appendChild(P.svg('title', {}, 'off the scale'));
+        g.appendChild(o);
+      }
     }
   }
   return svg;
@@ -186,16 +226,18 @@ P.orbit = function (x, z, kp, size) {
   const oz = m.t + side / 2;
   const sx = (v) => ox + (v - cx) * k;
   const sy = (v) => oz - (v - cz) * k;
-  const t = P.ticks(-half, half, 5);
-  for (const d of t.ticks) {
-    if (Math.abs(d) > half) continue;
-    svg.appendChild(P.svg('line', { x1: sx(cx + d), x2: sx(cx + d), y1: sy(cz + half), y2: sy(cz - half), class: 'grid' }));
-    svg.appendChild(P.svg('line', { x1: sx(cx - half), x2: sx(cx + half), y1: sy(cz + d), y2: sy(cz + d), class: 'grid' }));
-    svg.appendChild(P.svg('text', { x: sx(cx + d), y: sy(cz - half) + 15, 'text-anchor': 'middle' }, P.tickLabel(cx + d, t.step)));
-    svg.appendChild(P.svg('text', { x: sx(cx - half) - 5, y: sy(cz + d) + 4, 'text-anchor': 'end' }, P.tickLabel(cz + d, t.step)));
+  const tx = P.ticks(cx - half, cx + half, 5);
+  const tz = P.ticks(cz - half, cz + half, 5);
+  for (const v of tx.ticks) {
+    svg.appendChild(P.svg('line', { x1: sx(v), x2: sx(v), y1: sy(cz + half), y2: sy(cz - half), class: 'grid' }));
+    svg.appendChild(P.svg('text', { x: sx(v), y: sy(cz - half) + 15, 'text-anchor': 'middle' }, P.tickLabel(v, tx.step)));
+  }
+  for (const v of tz.ticks) {
+    svg.appendChild(P.svg('line', { x1: sx(cx - half), x2: sx(cx + half), y1: sy(v), y2: sy(v), class: 'grid' }));
+    svg.appendChild(P.svg('text', { x: sx(cx - half) - 5, y: sy(v) + 4, 'text-anchor': 'end' }, P.tickLabel(v, tz.step)));
   }
   svg.appendChild(P.svg('rect', { x: sx(cx - half), y: sy(cz + half), width: 2 * half * k, height: 2 * half * k, fill: 'none', class: 'axis' }));
-  svg.appendChild(P.svg('text', { x: sx(cx + half), y: s - 4, 'text-anchor': 'end' }, 'x [\u00b5m]'));
+  svg.appendChild(P.svg('text', { x: sx(cx + half), y: sy(cz - half) + 30, 'text-anchor': 'end' }, 'x [\u00b5m]'));
   svg.appendChild(P.svg('text', { x: 12, y: oz, 'text-anchor': 'middle', transform: 'rotate(-90 12 ' + oz + ')' }, 'z [\u00b5m]'));
   svg.appendChild(P.svg('path', { d: linePath(x, z, sx, sy), class: 'orbitpath' }));
   const g = P.svg('g', { class: 'keyphasors', 'data-points': kp.length });
@@ -237,6 +279,6 @@ P.polar = function (pts, size) {
     const op = n > 1 ? 0.25 + 0.75 * (i / (n - 1)) : 1;
     svg.appendChild(P.svg('circle', { cx: c + r(p.v.amplitude_um) * Math.sin(a), cy: c - r(p.v.amplitude_um) * Math.cos(a), r: p.latest ? 6 : 3, class: 'polar-pt ' + p.cls + (p.latest ? ' latest' : ''), 'fill-opacity': op.toFixed(2) }));
   });
-  svg.appendChild(P.svg('text', { x: c, y: s + 14, 'text-anchor': 'middle' }, 'radius: amplitude [\u00b5m pk]; angle: phase lag [deg], clockwise from the top'));
+  svg.appendChild(P.svg('text', { x: c, y: s + 14, 'text-anchor': 'middle' }, 'r: amplitude [\u00b5m pk], angle: phase lag [deg]'));
   return svg;
 };
