@@ -85,7 +85,7 @@ function trendsRender() {
       h,
       title: c.name + ' [' + c.unit + ']   newest ' + lastTxt + (b && b.value !== null ? '   baseline ' + R.fmt(b.value, b.std_error) : ''),
       ylabel: c.name + ' [' + c.unit + ']',
-      xlabel: 'window',
+      xlabel: 'window number',
       series: [{ x: xs, y, lo, hi }],
       hband,
       vmarks,
@@ -147,9 +147,9 @@ function oneXRender() {
       cls: d === 'z' ? 'z' : '',
     };
   });
-  const amp = P.chart({ w: 620, h: 150, ylabel: 'amplitude [\u00b5m pk]', xlabel: 'window', series: series('amplitude_um', 'amplitude_se_um'), robust: true, empty: 'no 1X vector yet (needs the phi channel)' });
+  const amp = P.chart({ w: 620, h: 150, ylabel: 'amplitude [\u00b5m pk]', xlabel: 'window number', series: series('amplitude_um', 'amplitude_se_um'), robust: true, empty: 'no 1X vector yet (needs the phi channel)' });
   amp.dataset.kind = 'amplitude';
-  const ph = P.chart({ w: 620, h: 150, ylabel: 'phase lag [deg]', xlabel: 'window', series: series('phase_deg', 'phase_se_deg'), empty: 'no 1X vector yet (needs the phi channel)' });
+  const ph = P.chart({ w: 620, h: 150, ylabel: 'phase lag [deg]', xlabel: 'window number', series: series('phase_deg', 'phase_se_deg'), empty: 'no 1X vector yet (needs the phi channel)' });
   ph.dataset.kind = 'phase';
   R.clear(document.getElementById('amp')).appendChild(amp);
   R.clear(document.getElementById('phase')).appendChild(ph);

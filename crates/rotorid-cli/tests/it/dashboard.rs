@@ -158,7 +158,7 @@ pub struct Fleet {
     pub dir: tempfile::TempDir,
     pub server: Server,
     pub url: String,
-    _worker: Proc,
+    worker: Proc,
     dashboard: Proc,
     /// The dashboard's `host:port`.
     pub addr: String,
@@ -175,20 +175,32 @@ impl Fleet {
         let dir = tempfile::tempdir().unwrap();
         let server = Server::start(&dir.path().join("js"));
         let url = server.url();
+        let mut f = Self {
+            dir,
+            server,
+            url,
+            worker: Proc(None),
+            dashboard: Proc(None),
+            addr: String::new(),
+        };
+        f.start_worker();
+        f
+    }
+
+    /// Start the worker (modulating, table1 for every machine).
+    pub fn start_worker(&mut self) {
         let worker = Command::new(assert_cmd::cargo::cargo_bin("rotorid"))
-            .args(["worker", "--nats", &url, "--scenario", "table1"])
+            .args(["worker", "--nats", &self.url, "--scenario", "table1"])
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()
             .unwrap();
-        Self {
-            dir,
-            server,
-            url,
-            _worker: Proc(Some(worker)),
-            dashboard: Proc(None),
-            addr: String::new(),
-        }
+        self.worker = Proc(Some(worker));
+    }
+
+    /// Kill the worker: windows published meanwhile wait in the stream.
+    pub fn stop_worker(&mut self) {
+        self.worker = Proc(None);
     }
 
     pub fn path(&self, name: &str) -> PathBuf {
