@@ -50,7 +50,11 @@ impl App {
 
 /// The embedded assets: path, content type, bytes.
 const ASSETS: &[(&str, &str, &str)] = &[
-    ("app.css", "text/css; charset=utf-8", include_str!("../assets/app.css")),
+    (
+        "app.css",
+        "text/css; charset=utf-8",
+        include_str!("../assets/app.css"),
+    ),
     (
         "common.js",
         "text/javascript; charset=utf-8",
@@ -92,7 +96,10 @@ pub fn router(app: Arc<App>) -> Router {
         .route("/api/machines/{id}/trend", get(trend))
         .route("/api/machines/{id}/trend.csv", get(trend_csv))
         .route("/api/machines/{id}/summary", get(latest_summary))
-        .route("/api/machines/{id}/windows/{window}/summary", get(window_summary))
+        .route(
+            "/api/machines/{id}/windows/{window}/summary",
+            get(window_summary),
+        )
         .route("/api/machines/{id}/orbit", get(orbit))
         .route("/api/events", get(events))
         .fallback(|| async { problem(StatusCode::NOT_FOUND, "no such page".into()) })
@@ -126,25 +133,44 @@ fn problem(status: StatusCode, message: String) -> Response {
     r
 }
 
-/// A machine id of the path, checked as the fleet checks ids.
-fn machine_id(id: &str) -> Result<&str, Response> {
-    rotorid_fleet::frame::check_machine_id(id)
-        .map(|()| id)
-        .map_err(|e| problem(StatusCode::NOT_FOUND, format!("machine {id:?}: {e}")))
+/// An error of a handler (answered by [`problem`]).
+#[derive(Debug)]
+pub struct Problem {
+    status: StatusCode,
+    message: String,
 }
 
-fn unknown(id: &str) -> Response {
-    problem(
+impl Problem {
+    fn new(status: StatusCode, message: String) -> Self {
+        Self { status, message }
+    }
+}
+
+impl IntoResponse for Problem {
+    fn into_response(self) -> Response {
+        problem(self.status, self.message)
+    }
+}
+
+type Answer = Result<Response, Problem>;
+
+/// A machine id of the path, checked as the fleet checks ids.
+fn machine_id(id: &str) -> Result<&str, Problem> {
+    rotorid_fleet::frame::check_machine_id(id)
+        .map(|()| id)
+        .map_err(|e| Problem::new(StatusCode::NOT_FOUND, format!("machine {id:?}: {e}")))
+}
+
+fn unknown(id: &str) -> Problem {
+    Problem::new(
         StatusCode::NOT_FOUND,
         format!("machine {id}: no window of it has been read"),
     )
 }
 
-async fn machine_page(Path(id): Path<String>) -> Response {
-    match machine_id(&id) {
-        Ok(_) => html(MACHINE_PAGE),
-        Err(r) => r,
-    }
+async fn machine_page(Path(id): Path<String>) -> Answer {
+    machine_id(&id)?;
+    Ok(html(MACHINE_PAGE))
 }
 
 async fn asset(Path(file): Path<String>) -> Response {
@@ -195,11 +221,8 @@ async fn machines(State(app): State<Arc<App>>) -> Response {
     json(&Machines { status, machines })
 }
 
-async fn machine(State(app): State<Arc<App>>, Path(id): Path<String>) -> Response {
-    let id = match machine_id(&id) {
-        Ok(id) => id,
-        Err(r) => return r,
-    };
+async fn machine(State(app): State<Arc<App>>, Path(id): Path<String>) -> Answer {
+    let id = machine_id(&id)?;
     #[derive(Serialize)]
     struct Detail {
         tile: crate::state::Tile,
@@ -210,9 +233,7 @@ async fn machine(State(app): State<Arc<App>>, Path(id): Path<String>) -> Respons
     }
     let st = app.shared.state.read().expect("not poisoned");
     let now = now_ms();
-    let Some(tile) = st.tile(id, now) else {
-        return unknown(id);
-    };
+    let tile = st.tile(id, now).ok_or_else(|| unknown(id))?;
     let identification = st.latest_json(id).and_then(|b| {
         let mut v: serde_json::Value = serde_json::from_slice(&b).ok()?;
         let mut ident = v.get_mut("identification")?.take();
@@ -222,29 +243,29 @@ async fn machine(State(app): State<Arc<App>>, Path(id): Path<String>) -> Respons
         }
         Some(ident)
     });
-    json(&Detail {
+    Ok(json(&Detail {
         tile,
         identification,
         errors: st.errors(id),
         server_ms: now,
-    })
+    }))
 }
 
 /// The query's `key=value` pairs, each key one of `allowed`, each value a whole number.
-fn numbers(query: Option<&str>, allowed: &[&str]) -> Result<Vec<(String, u64)>, Response> {
+fn numbers(query: Option<&str>, allowed: &[&str]) -> Result<Vec<(String, u64)>, Problem> {
     let mut out = Vec::new();
     for pair in query.unwrap_or("").split('&').filter(|p| !p.is_empty()) {
         let (k, v) = pair.split_once('=').unwrap_or((pair, ""));
         if !allowed.contains(&k) {
             let k: String = k.chars().take(40).collect();
-            return Err(problem(
+            return Err(Problem::new(
                 StatusCode::BAD_REQUEST,
                 format!("query parameter {k:?} is not one of {allowed:?}"),
             ));
         }
         let n = v.parse::<u64>().map_err(|_| {
             let v: String = v.chars().take(40).collect();
-            problem(
+            Problem::new(
                 StatusCode::BAD_REQUEST,
                 format!("query parameter {k} = {v:?} must be a whole number >= 0"),
             )
@@ -258,29 +279,26 @@ async fn trend(
     State(app): State<Arc<App>>,
     Path(id): Path<String>,
     RawQuery(q): RawQuery,
-) -> Response {
-    let id = match machine_id(&id) {
-        Ok(id) => id,
-        Err(r) => return r,
-    };
-    let q = match numbers(q.as_deref(), &["after", "last"]) {
-        Ok(q) => q,
-        Err(r) => return r,
-    };
+) -> Answer {
+    let id = machine_id(&id)?;
+    let q = numbers(q.as_deref(), &["after", "last"])?;
     let st = app.shared.state.read().expect("not poisoned");
     let history = st.settings.history;
     let get = |k: &str| q.iter().find(|(n, _)| n == k).map(|(_, v)| *v);
     let last = get("last").unwrap_or(history as u64);
     if last == 0 || last > history as u64 {
-        return problem(
+        return Err(Problem::new(
             StatusCode::BAD_REQUEST,
-            format!("last = {last} is out of range: 1 ..= {history} (the windows held per machine, --history)"),
-        );
+            format!(
+                "last = {last} is out of range: 1 ..= {history} (the windows held per \
+                 machine, --history)"
+            ),
+        ));
     }
-    match st.trend(id, get("after"), last as usize) {
-        Some(t) => json(&t),
-        None => unknown(id),
-    }
+    let t = st
+        .trend(id, get("after"), last as usize)
+        .ok_or_else(|| unknown(id))?;
+    Ok(json(&t))
 }
 
 fn attachment(mut r: Response, name: &str) -> Response {
@@ -290,47 +308,42 @@ fn attachment(mut r: Response, name: &str) -> Response {
     r
 }
 
-async fn trend_csv(State(app): State<Arc<App>>, Path(id): Path<String>) -> Response {
-    let id = match machine_id(&id) {
-        Ok(id) => id,
-        Err(r) => return r,
-    };
+async fn trend_csv(State(app): State<Arc<App>>, Path(id): Path<String>) -> Answer {
+    let id = machine_id(&id)?;
     let csv = app.shared.state.read().expect("not poisoned").trend_csv(id);
-    match csv {
-        Some(c) => attachment(
-            typed("text/csv; charset=utf-8", c.into()),
-            &format!("{id}-trend.csv"),
-        ),
-        None => unknown(id),
-    }
+    let csv = csv.ok_or_else(|| unknown(id))?;
+    Ok(attachment(
+        typed("text/csv; charset=utf-8", csv.into()),
+        &format!("{id}-trend.csv"),
+    ))
 }
 
-async fn latest_summary(State(app): State<Arc<App>>, Path(id): Path<String>) -> Response {
-    let id = match machine_id(&id) {
-        Ok(id) => id,
-        Err(r) => return r,
-    };
-    let j = app.shared.state.read().expect("not poisoned").latest_json(id);
-    match j {
-        Some(b) => attachment(typed("application/json", b.into()), &format!("{id}-latest.json")),
-        None => unknown(id),
-    }
+async fn latest_summary(State(app): State<Arc<App>>, Path(id): Path<String>) -> Answer {
+    let id = machine_id(&id)?;
+    let j = app
+        .shared
+        .state
+        .read()
+        .expect("not poisoned")
+        .latest_json(id);
+    let j = j.ok_or_else(|| unknown(id))?;
+    Ok(attachment(
+        typed("application/json", j.into()),
+        &format!("{id}-latest.json"),
+    ))
 }
 
 async fn window_summary(
     State(app): State<Arc<App>>,
     Path((id, window)): Path<(String, String)>,
-) -> Response {
-    let id = match machine_id(&id) {
-        Ok(id) => id,
-        Err(r) => return r,
-    };
-    let Ok(window) = window.parse::<u64>() else {
-        return problem(
+) -> Answer {
+    let id = machine_id(&id)?;
+    let window = window.parse::<u64>().map_err(|_| {
+        Problem::new(
             StatusCode::NOT_FOUND,
             format!("window {window:?} is not a window number (a whole number >= 0)"),
-        );
-    };
+        )
+    })?;
     let (seq, latest) = {
         let st = app.shared.state.read().expect("not poisoned");
         let latest = st.latest_json(id).filter(|b| {
@@ -343,51 +356,57 @@ async fn window_summary(
         (st.result_seq(id, window), latest)
     };
     if let Some(b) = latest {
-        return typed("application/json", b.into());
+        return Ok(typed("application/json", b.into()));
     }
     let not_held = || {
-        problem(
+        Problem::new(
             StatusCode::NOT_FOUND,
-            format!("machine {id} window {window}: no result held (the dashboard keeps the last --history windows)"),
+            format!(
+                "machine {id} window {window}: no result held (the dashboard keeps the last \
+                 --history windows)"
+            ),
         )
     };
-    let Some(seq) = seq.filter(|s| *s > 0) else {
-        return not_held();
-    };
+    let seq = seq.filter(|s| *s > 0).ok_or_else(not_held)?;
     let js = app.shared.js.lock().expect("not poisoned").clone();
-    let Some(js) = js else {
-        return problem(StatusCode::SERVICE_UNAVAILABLE, "not connected to NATS".into());
-    };
+    let js = js.ok_or_else(|| {
+        Problem::new(
+            StatusCode::SERVICE_UNAVAILABLE,
+            "not connected to NATS".into(),
+        )
+    })?;
     let got = tokio::time::timeout(Duration::from_secs(5), async {
         let s = js.get_stream(rotorid_fleet::IDENT_STREAM).await.ok()?;
         s.get_raw_message(seq).await.ok()
     })
-    .await;
-    match got {
-        Ok(Some(m)) if m.subject.as_str() == rotorid_fleet::ident_subject(id) => {
-            typed("application/json", m.payload.into())
-        }
-        Ok(Some(_)) | Ok(None) => not_held(),
-        Err(_) => problem(
+    .await
+    .map_err(|_| {
+        Problem::new(
             StatusCode::GATEWAY_TIMEOUT,
-            format!("NATS did not answer within 5 s (stream {})", rotorid_fleet::IDENT_STREAM),
-        ),
+            format!(
+                "NATS did not answer within 5 s (stream {})",
+                rotorid_fleet::IDENT_STREAM
+            ),
+        )
+    })?;
+    match got {
+        Some(m) if m.subject.as_str() == rotorid_fleet::ident_subject(id) => {
+            Ok(typed("application/json", m.payload.into()))
+        }
+        _ => Err(not_held()),
     }
 }
 
-async fn orbit(State(app): State<Arc<App>>, Path(id): Path<String>) -> Response {
-    let id = match machine_id(&id) {
-        Ok(id) => id,
-        Err(r) => return r,
-    };
+async fn orbit(State(app): State<Arc<App>>, Path(id): Path<String>) -> Answer {
+    let id = machine_id(&id)?;
     let st = app.shared.state.read().expect("not poisoned");
-    match st.orbit(id) {
-        Some(o) => json(o),
-        None => problem(
+    let o = st.orbit(id).ok_or_else(|| {
+        Problem::new(
             StatusCode::NOT_FOUND,
             format!("machine {id}: no raw window read yet"),
-        ),
-    }
+        )
+    })?;
+    Ok(json(o))
 }
 
 /// Decrements the count of open event streams when the stream is dropped.
@@ -418,9 +437,8 @@ async fn events(State(app): State<Arc<App>>) -> Response {
     let open = Open(Arc::clone(&app));
     let rx = app.shared.changes.subscribe();
     let first = Some(nats_event(&app));
-    let stream = futures_util::stream::unfold(
-        (rx, open, first),
-        |(mut rx, open, first)| async move {
+    let stream =
+        futures_util::stream::unfold((rx, open, first), |(mut rx, open, first)| async move {
             if let Some(e) = first {
                 return Some((Ok::<_, Infallible>(e), (rx, open, None)));
             }
@@ -445,8 +463,7 @@ async fn events(State(app): State<Arc<App>>) -> Response {
                 };
                 return Some((Ok(e), (rx, open, None)));
             }
-        },
-    );
+        });
     let mut r = Sse::new(stream)
         .keep_alive(KeepAlive::new().interval(Duration::from_secs(15)))
         .into_response();
@@ -482,7 +499,11 @@ fn presented(headers: &HeaderMap, query: Option<&str>) -> Vec<(String, bool)> {
     }
     for c in headers.get_all(header::COOKIE) {
         for part in c.to_str().unwrap_or("").split(';') {
-            if let Some(v) = part.trim().strip_prefix(TOKEN_COOKIE).and_then(|v| v.strip_prefix('=')) {
+            if let Some(v) = part
+                .trim()
+                .strip_prefix(TOKEN_COOKIE)
+                .and_then(|v| v.strip_prefix('='))
+            {
                 out.push((v.to_owned(), false));
             }
         }
@@ -512,7 +533,10 @@ fn secure(mut r: Response) -> Response {
         header::X_CONTENT_TYPE_OPTIONS,
         HeaderValue::from_static("nosniff"),
     );
-    h.insert(header::REFERRER_POLICY, HeaderValue::from_static("no-referrer"));
+    h.insert(
+        header::REFERRER_POLICY,
+        HeaderValue::from_static("no-referrer"),
+    );
     h.insert(header::X_FRAME_OPTIONS, HeaderValue::from_static("DENY"));
     if !h.contains_key(header::CACHE_CONTROL) {
         h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
@@ -525,7 +549,10 @@ async fn guard(State(app): State<Arc<App>>, req: Request, next: Next) -> Respons
     if req.method() != Method::GET && req.method() != Method::HEAD {
         let mut r = problem(
             StatusCode::METHOD_NOT_ALLOWED,
-            format!("{} is not allowed: the dashboard is read-only (GET, HEAD)", req.method()),
+            format!(
+                "{} is not allowed: the dashboard is read-only (GET, HEAD)",
+                req.method()
+            ),
         );
         r.headers_mut()
             .insert(header::ALLOW, HeaderValue::from_static("GET, HEAD"));
@@ -602,10 +629,24 @@ mod tests {
 
     #[test]
     fn loopback_hosts() {
-        for h in ["localhost", "localhost:8080", "127.0.0.1:1", "127.9.9.9", "[::1]:80", "[::1]"] {
+        for h in [
+            "localhost",
+            "localhost:8080",
+            "127.0.0.1:1",
+            "127.9.9.9",
+            "[::1]:80",
+            "[::1]",
+        ] {
             assert!(loopback_host(h), "{h}");
         }
-        for h in ["", "evil.example", "evil.example:8080", "10.0.0.1:80", "localhost.evil:1", "[::2]:1"] {
+        for h in [
+            "",
+            "evil.example",
+            "evil.example:8080",
+            "10.0.0.1:80",
+            "localhost.evil:1",
+            "[::2]:1",
+        ] {
             assert!(!loopback_host(h), "{h}");
         }
     }

@@ -165,10 +165,12 @@ impl Dashboard {
                 listen: config.listen,
                 source,
             })?;
-        let addr = listener.local_addr().map_err(|source| DashboardError::Bind {
-            listen: config.listen,
-            source,
-        })?;
+        let addr = listener
+            .local_addr()
+            .map_err(|source| DashboardError::Bind {
+                listen: config.listen,
+                source,
+            })?;
         Ok(Self {
             listener,
             addr,
@@ -182,8 +184,14 @@ impl Dashboard {
     }
 
     /// Read the fleet and serve until `shutdown` resolves.
-    pub async fn run(self, shutdown: impl Future<Output = ()> + Send + 'static) -> Result<(), DashboardError> {
-        let shared = follow::Shared::new(state::FleetState::new(self.config.settings), &self.config.nats);
+    pub async fn run(
+        self,
+        shutdown: impl Future<Output = ()> + Send + 'static,
+    ) -> Result<(), DashboardError> {
+        let shared = follow::Shared::new(
+            state::FleetState::new(self.config.settings),
+            &self.config.nats,
+        );
         tokio::spawn(follow::start(
             Arc::clone(&shared),
             self.config.nats.clone(),

@@ -228,7 +228,10 @@ mod tests {
         let phi: Vec<f64> = t.iter().map(|t| w * t + 0.3).collect();
         // x = 2 um cos(phi - 1), z = 1 um sin(phi - 1) + 0.5 um
         let x = phi.iter().map(|p| 2e-6 * (p - 1.0).cos()).collect();
-        let z = phi.iter().map(|p| 1e-6 * (p - 1.0).sin() + 0.5e-6).collect();
+        let z = phi
+            .iter()
+            .map(|p| 1e-6 * (p - 1.0).sin() + 0.5e-6)
+            .collect();
         let mut channels = vec![
             Channel {
                 name: "x".into(),

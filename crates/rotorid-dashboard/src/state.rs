@@ -278,7 +278,9 @@ pub enum MessageError {
         named: String,
     },
     /// More machines than [`Settings::max_machines`].
-    #[error("machine {id}: not shown, the dashboard already shows {max} machines (--max-machines)")]
+    #[error(
+        "machine {id}: not shown, the dashboard already shows {max} machines (--max-machines)"
+    )]
     TooManyMachines {
         /// The machine.
         id: String,
@@ -374,7 +376,11 @@ impl Machine {
                 .and_then(|l| l.json.as_ref())
                 .map_or(0, Bytes::len)
             + self.alerts.capacity() * (std::mem::size_of::<AlertView>() + 64)
-            + self.errors.iter().map(|e| e.error.len() + 48).sum::<usize>()
+            + self
+                .errors
+                .iter()
+                .map(|e| e.error.len() + 48)
+                .sum::<usize>()
     }
 }
 
@@ -686,7 +692,12 @@ impl FleetState {
                 }
             })
             .collect();
-        let ox: Vec<OneXPoint> = m.one_x.iter().filter(|p| newer(p.window)).copied().collect();
+        let ox: Vec<OneXPoint> = m
+            .one_x
+            .iter()
+            .filter(|p| newer(p.window))
+            .copied()
+            .collect();
         let skip = ox.len().saturating_sub(last);
         Some(Trend {
             id: id.to_owned(),
@@ -718,7 +729,10 @@ impl FleetState {
              [deg],x 1X phase lag std_error [deg],z 1X amplitude [um],z 1X amplitude \
              std_error [um],z 1X phase lag [deg],z 1X phase lag std_error [deg]\n",
         );
-        let num = |v: Option<f64>| v.filter(|v| v.is_finite()).map_or(String::new(), |v| v.to_string());
+        let num = |v: Option<f64>| {
+            v.filter(|v| v.is_finite())
+                .map_or(String::new(), |v| v.to_string())
+        };
         let ox: BTreeMap<u64, &OneXPoint> = m.one_x.iter().map(|p| (p.window, p)).collect();
         for p in &m.points {
             let _ = write!(out, "{},{},{}", p.window, p.t0_s, p.arrived_ms);
@@ -839,7 +853,8 @@ mod tests {
         let order = [3u64, 1, 0, 2, 9, 4, 8, 5, 7, 6, 0, 12, 11, 10];
         for (i, &w) in order.iter().enumerate() {
             let r = result("a", w, &[("kx", "N/m", w as f64, 1.0)]);
-            s.apply_result("a", i as u64 + 1, 1000 * w as i64, &r).unwrap();
+            s.apply_result("a", i as u64 + 1, 1000 * w as i64, &r)
+                .unwrap();
         }
         let t = s.trend("a", None, usize::MAX).unwrap();
         let ws: Vec<u64> = t.windows.iter().map(|p| p.window).collect();
@@ -879,7 +894,11 @@ mod tests {
     #[test]
     fn parameters_are_those_the_results_carry_and_states_are_ordered_worst_first() {
         let mut s = FleetState::new(Settings::default());
-        let r = result("b", 0, &[("kxz", "N/m", 5.0, 0.5), ("<i>", "x&y", 1.0, 0.1)]);
+        let r = result(
+            "b",
+            0,
+            &[("kxz", "N/m", 5.0, 0.5), ("<i>", "x&y", 1.0, 0.1)],
+        );
         s.apply_result("b", 1, 0, &r).unwrap();
         let t = s.tile("b", 0).unwrap();
         assert_eq!(t.parameters[0].name, "kxz");
@@ -893,8 +912,10 @@ mod tests {
         let alert = serde_json::json!({"fleet_schema":1,"machine":"a","window":0,"t0_s":0.0,
             "parameter":"kx","unit":"N/m","baseline":1.0,"baseline_std_error":0.1,"value":2.0,
             "std_error":0.1,"change":1.0,"relative_change":1.0,"z":7.0,"previous_z":6.0});
-        s.apply_alert("a", 0, &serde_json::to_vec(&alert).unwrap()).unwrap();
-        let order: Vec<(String, &str)> = s.tiles(1000).into_iter().map(|t| (t.id, t.state)).collect();
+        s.apply_alert("a", 0, &serde_json::to_vec(&alert).unwrap())
+            .unwrap();
+        let order: Vec<(String, &str)> =
+            s.tiles(1000).into_iter().map(|t| (t.id, t.state)).collect();
         assert_eq!(
             order,
             vec![
@@ -907,10 +928,18 @@ mod tests {
         s.apply_result("a", 3, 0, &result("a", 10, &[])).unwrap();
         assert_eq!(s.tile("a", 1000).unwrap().state, "ok");
         // a message naming another machine than its subject is refused
-        let e = s.apply_result("a", 4, 0, &result("b", 11, &[])).unwrap_err();
+        let e = s
+            .apply_result("a", 4, 0, &result("b", 11, &[]))
+            .unwrap_err();
         assert!(matches!(e, MessageError::WrongMachine { .. }), "{e}");
-        let e = s.apply_result("a", 4, 0, &Bytes::from_static(b"{")).unwrap_err();
-        assert!(e.to_string().contains("rotorid.ident.a: not a valid result"), "{e}");
+        let e = s
+            .apply_result("a", 4, 0, &Bytes::from_static(b"{"))
+            .unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("rotorid.ident.a: not a valid result"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -12,10 +12,12 @@ use rotorid_fleet::worker::shutdown_signal;
 /// Serve a live web page of the fleet: every machine's identified parameters, trends
 /// with uncertainty, alerts, orbits and 1X vectors (read-only; assets in the binary).
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Examples:\n  rotorid dashboard --nats nats://127.0.0.1:4222\n    \
+#[command(
+    after_help = "Examples:\n  rotorid dashboard --nats nats://127.0.0.1:4222\n    \
                         then open http://127.0.0.1:8080/\n  rotorid dashboard --nats \
                         nats://127.0.0.1:4222 --listen 0.0.0.0:8080 --token-file \
-                        /etc/rotorid/token\n    then open http://HOST:8080/?token=TOKEN once")]
+                        /etc/rotorid/token\n    then open http://HOST:8080/?token=TOKEN once"
+)]
 pub struct DashboardArgs {
     /// The NATS server the workers use.
     #[arg(long, value_name = "URL")]
@@ -47,7 +49,8 @@ pub struct DashboardArgs {
 
 /// The token in `path`, trimmed of white space at its ends.
 fn read_token(path: &PathBuf) -> anyhow::Result<String> {
-    let f = std::fs::File::open(path).with_context(|| format!("--token-file {}", path.display()))?;
+    let f =
+        std::fs::File::open(path).with_context(|| format!("--token-file {}", path.display()))?;
     let mut s = String::new();
     f.take(4096)
         .read_to_string(&mut s)
@@ -85,7 +88,10 @@ pub fn run(args: DashboardArgs) -> anyhow::Result<()> {
         } else {
             ""
         };
-        outln!("rotorid dashboard: http://{addr}/ reading {}{how}", args.nats)?;
+        outln!(
+            "rotorid dashboard: http://{addr}/ reading {}{how}",
+            args.nats
+        )?;
         d.run(shutdown_signal()).await?;
         anyhow::Ok(())
     })

@@ -125,10 +125,7 @@ pub fn wait_for<T>(what: &str, mut f: impl FnMut() -> Option<T>) -> T {
         if let Some(v) = f() {
             return v;
         }
-        assert!(
-            t.elapsed() < PATIENCE,
-            "{what}: not within {PATIENCE:?}"
-        );
+        assert!(t.elapsed() < PATIENCE, "{what}: not within {PATIENCE:?}");
         std::thread::sleep(Duration::from_millis(100));
     }
 }
@@ -288,25 +285,28 @@ impl Fleet {
     /// `/api/machines` once every machine of [`MACHINES`] shows all its windows, press-4
     /// its alert, and every machine its baseline.
     pub fn settled(&self) -> Value {
-        wait_for("every window, the alert and the baselines on the dashboard", || {
-            let v = get(&self.addr, "/api/machines").json();
-            let ms = v["machines"].as_array()?;
-            for (id, windows) in MACHINES {
-                let t = ms.iter().find(|t| t["id"] == id)?;
-                if t["results"] != windows || t["window"] != windows - 1 {
-                    return None;
+        wait_for(
+            "every window, the alert and the baselines on the dashboard",
+            || {
+                let v = get(&self.addr, "/api/machines").json();
+                let ms = v["machines"].as_array()?;
+                for (id, windows) in MACHINES {
+                    let t = ms.iter().find(|t| t["id"] == id)?;
+                    if t["results"] != windows || t["window"] != windows - 1 {
+                        return None;
+                    }
+                    let trend = get(&self.addr, &format!("/api/machines/{id}/trend")).json();
+                    if trend["baseline"].as_array()?.is_empty() {
+                        return None;
+                    }
+                    if trend["one_x"].as_array()?.len() as u64 != windows {
+                        return None;
+                    }
                 }
-                let trend = get(&self.addr, &format!("/api/machines/{id}/trend")).json();
-                if trend["baseline"].as_array()?.is_empty() {
-                    return None;
-                }
-                if trend["one_x"].as_array()?.len() as u64 != windows {
-                    return None;
-                }
-            }
-            let press = ms.iter().find(|t| t["id"] == "press-4")?;
-            (press["state"] == "alert").then_some(v)
-        })
+                let press = ms.iter().find(|t| t["id"] == "press-4")?;
+                (press["state"] == "alert").then_some(v)
+            },
+        )
     }
 }
 
@@ -327,17 +327,28 @@ pub fn read_streams(url: &str) -> Streams {
         let fleet = rotorid_fleet::nats::Fleet::connect(url, Duration::from_secs(10))
             .await
             .unwrap();
-        let mut s = fleet.js.get_stream(rotorid_fleet::IDENT_STREAM).await.unwrap();
+        let mut s = fleet
+            .js
+            .get_stream(rotorid_fleet::IDENT_STREAM)
+            .await
+            .unwrap();
         let last = s.info().await.unwrap().state.last_sequence;
         let mut results = BTreeMap::new();
         for seq in 1..=last {
             let m = s.get_raw_message(seq).await.unwrap();
             if let Some(id) = m.subject.as_str().strip_prefix("rotorid.ident.") {
                 let v: Value = serde_json::from_slice(&m.payload).unwrap();
-                results.insert((id.to_owned(), v["window"].as_u64().unwrap()), m.payload.to_vec());
+                results.insert(
+                    (id.to_owned(), v["window"].as_u64().unwrap()),
+                    m.payload.to_vec(),
+                );
             }
         }
-        let kv = fleet.js.get_key_value(rotorid_fleet::DRIFT_BUCKET).await.unwrap();
+        let kv = fleet
+            .js
+            .get_key_value(rotorid_fleet::DRIFT_BUCKET)
+            .await
+            .unwrap();
         let mut drift = BTreeMap::new();
         for (id, _) in MACHINES {
             let b = kv.get(id).await.unwrap().unwrap();
@@ -445,7 +456,12 @@ fn the_api_serves_what_the_workers_published() {
             let r: Value = serde_json::from_slice(bytes).unwrap();
             assert_eq!(p["window"], w as u64);
             assert_eq!(p["t0_s"], r["t0_s"]);
-            for (i, q) in r["identification"]["parameters"].as_array().unwrap().iter().enumerate() {
+            for (i, q) in r["identification"]["parameters"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .enumerate()
+            {
                 assert_eq!(p["values"][i], q["value"], "{id} window {w}");
                 assert_eq!(p["std_errors"][i], q["std_error"], "{id} window {w}");
             }
@@ -455,7 +471,10 @@ fn the_api_serves_what_the_workers_published() {
         }
         let latest = get(&addr, &format!("/api/machines/{id}/summary"));
         assert_eq!(latest.body, streams.results[&(id.to_owned(), windows - 1)]);
-        assert!(latest.header("content-disposition").unwrap().contains("attachment"));
+        assert!(latest
+            .header("content-disposition")
+            .unwrap()
+            .contains("attachment"));
 
         // the baseline band: the drift state's baseline, as the worker formed it
         let base = &streams.drift[id]["baseline"];
@@ -491,7 +510,11 @@ fn the_api_serves_what_the_workers_published() {
     let rel = a["relative_change"].as_f64().unwrap();
     assert!((rel + 0.05).abs() < 0.005, "{a}");
     let trend = get(&addr, "/api/machines/press-4/trend").json();
-    assert!(trend["alerts"].as_array().unwrap().iter().any(|a| a["parameter"] == "kx"));
+    assert!(trend["alerts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|a| a["parameter"] == "kx"));
 
     // 1X of every window against a DFT of the recording's own samples
     for (id, _) in MACHINES.iter().take(3) {
@@ -512,7 +535,10 @@ fn the_api_serves_what_the_workers_published() {
                     amp * 1e6
                 );
                 let d = (got_lag - lag + 180.0).rem_euclid(360.0) - 180.0;
-                assert!(d.abs() < 0.1, "{id} window {w} {probe}: {got_lag} deg vs DFT {lag}");
+                assert!(
+                    d.abs() < 0.1,
+                    "{id} window {w} {probe}: {got_lag} deg vs DFT {lag}"
+                );
                 assert!(v["amplitude_se_um"].as_f64().unwrap() > 0.0);
             }
             assert!((p["speed_rpm"].as_f64().unwrap() - 1200.0).abs() < 1e-6);
@@ -534,7 +560,8 @@ fn the_api_serves_what_the_workers_published() {
         for j in 1..20 {
             let at = 2.0 + 0.05 * j as f64;
             assert!(
-                kp.iter().any(|k| (k["t_s"].as_f64().unwrap() - at).abs() < 1e-9),
+                kp.iter()
+                    .any(|k| (k["t_s"].as_f64().unwrap() - at).abs() < 1e-9),
                 "no keyphasor at {at} s: {kp:?}"
             );
         }
@@ -545,17 +572,29 @@ fn the_api_serves_what_the_workers_published() {
             let i = (((t - 2.0) / 1e-4).floor() as usize + 20_000).min(x.len() - 2);
             let (lo, hi) = (x[i].min(x[i + 1]) * 1e6, x[i].max(x[i + 1]) * 1e6);
             let kx = k["x_um"].as_f64().unwrap();
-            assert!(kx >= lo - 1e-9 && kx <= hi + 1e-9, "{k} between {lo} and {hi}");
+            assert!(
+                kx >= lo - 1e-9 && kx <= hi + 1e-9,
+                "{k} between {lo} and {hi}"
+            );
         }
     }
 
     // limits, refusals, the read-only rule
     let r = get(&addr, "/api/machines/pump-1/trend?last=0");
     assert_eq!(r.status, 400);
-    assert!(r.text().contains("last = 0 is out of range: 1 ..= 50"), "{}", r.text());
+    assert!(
+        r.text().contains("last = 0 is out of range: 1 ..= 50"),
+        "{}",
+        r.text()
+    );
     assert_eq!(get(&addr, "/api/machines/pump-1/trend?last=51").status, 400);
     let r = get(&addr, "/api/machines/pump-1/trend?last=2&after=0");
-    let ws: Vec<u64> = r.json()["windows"].as_array().unwrap().iter().map(|w| w["window"].as_u64().unwrap()).collect();
+    let ws: Vec<u64> = r.json()["windows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w["window"].as_u64().unwrap())
+        .collect();
     assert_eq!(ws, [1, 2]);
     let r = get(&addr, "/api/machines/pump-1/trend?evil=1");
     assert_eq!(r.status, 400);
@@ -564,7 +603,10 @@ fn the_api_serves_what_the_workers_published() {
     assert_eq!(get(&addr, "/api/machines/a.b/trend").status, 404);
     assert_eq!(get(&addr, "/machine/a%20b").status, 404);
     assert_eq!(get(&addr, "/machine/pump-1").status, 200);
-    assert_eq!(get(&addr, "/api/machines/pump-1/windows/77/summary").status, 404);
+    assert_eq!(
+        get(&addr, "/api/machines/pump-1/windows/77/summary").status,
+        404
+    );
     assert_eq!(get(&addr, "/nothing").status, 404);
     for m in ["POST", "PUT", "DELETE", "PATCH"] {
         for path in ["/api/machines", "/", "/api/events", "/nothing"] {
@@ -576,27 +618,45 @@ fn the_api_serves_what_the_workers_published() {
     let head = request("HEAD", &addr, "/", &[]);
     assert_eq!((head.status, head.body.len()), (200, 0));
     // only requests for a loopback host (no DNS rebinding from another site)
-    let r = request("GET", &addr, "/api/machines", &[("Host", "evil.example:8080")]);
+    let r = request(
+        "GET",
+        &addr,
+        "/api/machines",
+        &[("Host", "evil.example:8080")],
+    );
     assert_eq!(r.status, 403);
     assert!(r.text().contains("--token-file"), "{}", r.text());
     // the pages: no script but our own files, and no framing
     let page = get(&addr, "/");
     let csp = page.header("content-security-policy").unwrap();
-    assert!(csp.contains("script-src 'self'") && csp.contains("default-src 'none'"), "{csp}");
+    assert!(
+        csp.contains("script-src 'self'") && csp.contains("default-src 'none'"),
+        "{csp}"
+    );
     assert!(page.text().contains("/assets/fleet.js"));
     assert!(!page.text().contains("http://") && !page.text().contains("https://"));
     for a in ["app.css", "common.js", "plot.js", "fleet.js", "machine.js"] {
         let r = get(&addr, &format!("/assets/{a}"));
         assert_eq!(r.status, 200);
         // no request to any other host: no absolute URL in any asset
-        assert!(!r.text().contains("//cdn") && !r.text().contains("https://"), "{a}");
-        assert!(!r.text().contains("innerHTML"), "{a}: bus text only through textContent");
+        assert!(
+            !r.text().contains("//cdn") && !r.text().contains("https://"),
+            "{a}"
+        );
+        assert!(
+            !r.text().contains("innerHTML"),
+            "{a}: bus text only through textContent"
+        );
     }
 }
 
 /// Read server-sent events from `/api/events` until `want` is seen in a `machine` event;
 /// `ready` is told when the stream is open (its first event, `nats`, has come).
-fn sse_until(addr: &str, ready: std::sync::mpsc::Sender<()>, want: impl Fn(&Value) -> bool) -> Value {
+fn sse_until(
+    addr: &str,
+    ready: std::sync::mpsc::Sender<()>,
+    want: impl Fn(&Value) -> bool,
+) -> Value {
     let mut s = TcpStream::connect(addr).unwrap();
     s.set_read_timeout(Some(PATIENCE)).unwrap();
     write!(s, "GET /api/events HTTP/1.1\r\nHost: {addr}\r\n\r\n").unwrap();
@@ -606,7 +666,10 @@ fn sse_until(addr: &str, ready: std::sync::mpsc::Sender<()>, want: impl Fn(&Valu
     let t = Instant::now();
     loop {
         line.clear();
-        assert!(r.read_line(&mut line).unwrap() > 0, "the event stream ended");
+        assert!(
+            r.read_line(&mut line).unwrap() > 0,
+            "the event stream ended"
+        );
         assert!(t.elapsed() < PATIENCE, "no such event within {PATIENCE:?}");
         if let Some(e) = line.trim().strip_prefix("event:") {
             event = e.trim().to_owned();
@@ -638,25 +701,38 @@ fn nats_gone_shows_in_the_status_and_the_dashboard_carries_on() {
         (s["nats"]["connected"] == false).then_some(s)
     });
     assert!(
-        st["nats"]["problems"].as_object().unwrap().values().any(|p| p.as_str().unwrap().contains("unreachable")),
+        st["nats"]["problems"]
+            .as_object()
+            .unwrap()
+            .values()
+            .any(|p| p.as_str().unwrap().contains("unreachable")),
         "{st}"
     );
     // still serving what it has
     let during = get(&addr, "/api/machines").json();
     assert_eq!(during["machines"].as_array().unwrap().len(), 4);
     assert_eq!(get(&addr, "/").status, 200);
-    assert_eq!(get(&addr, "/api/machines/pump-1/trend").json()["windows"].as_array().unwrap().len(), 3);
+    assert_eq!(
+        get(&addr, "/api/machines/pump-1/trend").json()["windows"]
+            .as_array()
+            .unwrap()
+            .len(),
+        3
+    );
     f.server.resume();
     wait_for("NATS back and every reader reading", || {
         let s = get(&addr, "/api/status").json();
-        (s["nats"]["connected"] == true && s["nats"]["problems"].as_object()?.is_empty()).then_some(())
+        (s["nats"]["connected"] == true && s["nats"]["problems"].as_object()?.is_empty())
+            .then_some(())
     });
     // a new window after the outage reaches the dashboard, and is pushed to open pages
     let addr2 = addr.clone();
     let (tx, rx) = std::sync::mpsc::channel();
     // (an event carries the machine's tile as it is when sent: windows 3 to 5 come fast)
     let watcher = std::thread::spawn(move || {
-        sse_until(&addr2, tx, |t| t["id"] == "pump-1" && t["window"].as_u64() >= Some(3))
+        sse_until(&addr2, tx, |t| {
+            t["id"] == "pump-1" && t["window"].as_u64() >= Some(3)
+        })
     });
     rx.recv_timeout(PATIENCE).expect("the event stream opens");
     f.publish(&recs["pump-1"], "pump-1", 3);
@@ -664,11 +740,18 @@ fn nats_gone_shows_in_the_status_and_the_dashboard_carries_on() {
     assert!(ev["results"].as_u64().unwrap() >= 4, "{ev}");
     let ws = wait_for("windows 3 to 5 of pump-1 after the outage", || {
         let t = get(&addr, "/api/machines/pump-1/trend").json();
-        let ws: Vec<u64> = t["windows"].as_array()?.iter().map(|w| w["window"].as_u64().unwrap()).collect();
+        let ws: Vec<u64> = t["windows"]
+            .as_array()?
+            .iter()
+            .map(|w| w["window"].as_u64().unwrap())
+            .collect();
         (ws.len() == 6).then_some(ws)
     });
     assert_eq!(ws, [0, 1, 2, 3, 4, 5]);
-    assert_eq!(get(&addr, "/api/machines").json()["machines"][0]["id"], "press-4");
+    assert_eq!(
+        get(&addr, "/api/machines").json()["machines"][0]["id"],
+        "press-4"
+    );
     assert_eq!(before["machines"].as_array().unwrap().len(), 4);
 }
 
@@ -676,45 +759,80 @@ fn nats_gone_shows_in_the_status_and_the_dashboard_carries_on() {
 fn off_loopback_the_dashboard_needs_a_token_and_checks_it() {
     let dir = tempfile::tempdir().unwrap();
     let out = rotorid()
-        .args(["dashboard", "--nats", "nats://127.0.0.1:1", "--listen", "0.0.0.0:0"])
+        .args([
+            "dashboard",
+            "--nats",
+            "nats://127.0.0.1:1",
+            "--listen",
+            "0.0.0.0:0",
+        ])
         .output()
         .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("--listen 0.0.0.0:0 is not a loopback address") && err.contains("--token-file FILE"),
+        err.contains("--listen 0.0.0.0:0 is not a loopback address")
+            && err.contains("--token-file FILE"),
         "{err}"
     );
     let short = dir.path().join("short");
     std::fs::write(&short, "abc\n").unwrap();
     let out = rotorid()
-        .args(["dashboard", "--nats", "nats://127.0.0.1:1", "--listen", "0.0.0.0:0", "--token-file"])
+        .args([
+            "dashboard",
+            "--nats",
+            "nats://127.0.0.1:1",
+            "--listen",
+            "0.0.0.0:0",
+            "--token-file",
+        ])
         .arg(&short)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && err.contains("3 characters; it must have 16 to 256"), "{err}");
+    assert!(
+        !out.status.success() && err.contains("3 characters; it must have 16 to 256"),
+        "{err}"
+    );
 
     // with a token: every request needs it (no NATS server at all: it serves anyway)
     let token = "s3cret-token-0123456789";
     let file = dir.path().join("token");
     std::fs::write(&file, format!("{token}\n")).unwrap();
     let mut child = Command::new(assert_cmd::cargo::cargo_bin("rotorid"))
-        .args(["dashboard", "--nats", "nats://127.0.0.1:1", "--listen", "0.0.0.0:0", "--token-file"])
+        .args([
+            "dashboard",
+            "--nats",
+            "nats://127.0.0.1:1",
+            "--listen",
+            "0.0.0.0:0",
+            "--token-file",
+        ])
         .arg(&file)
         .stdout(Stdio::piped())
         .spawn()
         .unwrap();
     let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
     let _guard = Proc(Some(child));
-    let port = line.split("0.0.0.0:").nth(1).unwrap().split('/').next().unwrap();
+    let port = line
+        .split("0.0.0.0:")
+        .nth(1)
+        .unwrap()
+        .split('/')
+        .next()
+        .unwrap();
     let addr = format!("127.0.0.1:{port}");
     let r = get(&addr, "/api/machines");
     assert_eq!(r.status, 401);
     assert!(r.text().contains("?token="), "{}", r.text());
     let wrong = format!("Bearer {}x", &token[..token.len() - 1]);
-    assert_eq!(request("GET", &addr, "/api/machines", &[("Authorization", &wrong)]).status, 401);
+    assert_eq!(
+        request("GET", &addr, "/api/machines", &[("Authorization", &wrong)]).status,
+        401
+    );
     let right = format!("Bearer {token}");
     let r = request("GET", &addr, "/api/machines", &[("Authorization", &right)]);
     assert_eq!(r.status, 200, "{}", r.text());
@@ -725,13 +843,34 @@ fn off_loopback_the_dashboard_needs_a_token_and_checks_it() {
     assert_eq!(r.status, 303);
     assert_eq!(r.header("location"), Some("/machine/m-1"));
     let cookie = r.header("set-cookie").unwrap().to_owned();
-    assert!(cookie.contains("HttpOnly") && cookie.contains("SameSite=Strict"), "{cookie}");
+    assert!(
+        cookie.contains("HttpOnly") && cookie.contains("SameSite=Strict"),
+        "{cookie}"
+    );
     let pair = cookie.split(';').next().unwrap();
-    assert_eq!(request("GET", &addr, "/machine/m-1", &[("Cookie", pair)]).status, 200);
-    assert_eq!(request("GET", &addr, "/machine/m-1", &[("Cookie", "rotorid_token=nope")]).status, 401);
+    assert_eq!(
+        request("GET", &addr, "/machine/m-1", &[("Cookie", pair)]).status,
+        200
+    );
+    assert_eq!(
+        request(
+            "GET",
+            &addr,
+            "/machine/m-1",
+            &[("Cookie", "rotorid_token=nope")]
+        )
+        .status,
+        401
+    );
     // with a token any Host is accepted (it is not reachable without the token)
     assert_eq!(
-        request("GET", &addr, "/api/status", &[("Authorization", &right), ("Host", "plant-screen:8080")]).status,
+        request(
+            "GET",
+            &addr,
+            "/api/status",
+            &[("Authorization", &right), ("Host", "plant-screen:8080")]
+        )
+        .status,
         200
     );
 }

@@ -90,14 +90,20 @@ async fn until(c: &Client, what: &str, script: &str) -> Value {
         if !(v.is_null() || v == Value::Bool(false)) {
             return v;
         }
-        assert!(t.elapsed() < PATIENCE, "{what}: not within {PATIENCE:?} (last {v})");
+        assert!(
+            t.elapsed() < PATIENCE,
+            "{what}: not within {PATIENCE:?} (last {v})"
+        );
         tokio::time::sleep(Duration::from_millis(100)).await;
     }
 }
 
 /// A value as the page shows it, "1 194 930 ± 140": (value, standard error).
 fn shown(text: &str) -> (f64, Option<f64>) {
-    let t: String = text.chars().filter(|c| !c.is_whitespace() && *c != '\u{2009}').collect();
+    let t: String = text
+        .chars()
+        .filter(|c| !c.is_whitespace() && *c != '\u{2009}')
+        .collect();
     match t.split_once('±') {
         Some((v, e)) => (v.parse().unwrap(), Some(e.parse().unwrap())),
         None => (t.parse().unwrap(), None),
@@ -178,7 +184,12 @@ async fn the_pages_in_a_real_browser_show_the_fleet_and_update_live() {
     assert_eq!(ids, ["press-4", "evil-5", "fan-3", "pump-1", "pump-2"]);
     for t in tiles {
         let id = t["id"].as_str().unwrap();
-        let a = api["machines"].as_array().unwrap().iter().find(|m| m["id"] == id).unwrap();
+        let a = api["machines"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["id"] == id)
+            .unwrap();
         assert_eq!(t["state"], a["state"], "{id}");
         assert_eq!(t["window"], a["window"].to_string(), "{id}");
         assert_eq!(t["href"], format!("/machine/{id}"));
@@ -189,11 +200,21 @@ async fn the_pages_in_a_real_browser_show_the_fleet_and_update_live() {
             assert_eq!(r[0], p["name"], "{id}");
             assert_eq!(r[2], p["unit"], "{id}");
             let (v, se) = shown(r[1].as_str().unwrap());
-            let (pv, pse) = (p["value"].as_f64().unwrap(), p["std_error"].as_f64().unwrap());
+            let (pv, pse) = (
+                p["value"].as_f64().unwrap(),
+                p["std_error"].as_f64().unwrap(),
+            );
             // rounded to the standard error's second significant digit
-            assert!((v - pv).abs() <= 0.05 * pse * (1.0 + 1e-9), "{id} {}: {r} vs {p}", p["name"]);
+            assert!(
+                (v - pv).abs() <= 0.05 * pse * (1.0 + 1e-9),
+                "{id} {}: {r} vs {p}",
+                p["name"]
+            );
             let se = se.expect("every value here has a standard error");
-            assert!((se - pse).abs() <= 0.05 * pse * (1.0 + 1e-9), "{id}: {r} vs {p}");
+            assert!(
+                (se - pse).abs() <= 0.05 * pse * (1.0 + 1e-9),
+                "{id}: {r} vs {p}"
+            );
         }
     }
     let press = &tiles[0];
@@ -206,10 +227,19 @@ async fn the_pages_in_a_real_browser_show_the_fleet_and_update_live() {
     assert!((pct + 5.0).abs() < 0.5, "kx dropped 5 %: {alert}");
     // the bus's text as text: no element made of it, no script run
     let evil = &tiles[1];
-    assert_eq!(evil["params"][0], json!(["kxz", "1\u{2009}500\u{2009}000 ± 2\u{2009}000", "N/m"]));
+    assert_eq!(
+        evil["params"][0],
+        json!(["kxz", "1\u{2009}500\u{2009}000 ± 2\u{2009}000", "N/m"])
+    );
     assert_eq!(evil["params"][1][0], "<img src=x onerror=window.__pwned=1>");
     assert_eq!(evil["params"][1][2], "<b>N</b>");
-    assert!(evil["error"].as_str().unwrap().contains("<script>window.__pwned=2</script> & <i>x</i>"), "{evil}");
+    assert!(
+        evil["error"]
+            .as_str()
+            .unwrap()
+            .contains("<script>window.__pwned=2</script> & <i>x</i>"),
+        "{evil}"
+    );
     let injected = c
         .execute(
             "return [document.querySelectorAll('img, script:not([src]), i').length, typeof window.__pwned];",
@@ -219,12 +249,16 @@ async fn the_pages_in_a_real_browser_show_the_fleet_and_update_live() {
         .unwrap();
     assert_eq!(injected, json!([0, "undefined"]));
     let fleet_tab = c.window().await.unwrap();
-    c.execute("window.__marker = 'fleet page loaded once';", vec![]).await.unwrap();
+    c.execute("window.__marker = 'fleet page loaded once';", vec![])
+        .await
+        .unwrap();
 
     // the machine page of press-4, in a second tab
     let tab = c.new_window(true).await.unwrap();
     c.switch_to_window(tab.handle.clone()).await.unwrap();
-    c.goto(&format!("http://{addr}/machine/press-4")).await.unwrap();
+    c.goto(&format!("http://{addr}/machine/press-4"))
+        .await
+        .unwrap();
     let trend = tokio::task::spawn_blocking({
         let addr = addr.clone();
         move || get(&addr, "/api/machines/press-4/trend").json()
@@ -237,9 +271,19 @@ async fn the_pages_in_a_real_browser_show_the_fleet_and_update_live() {
         band: s.querySelector('path.band').getAttribute('d').length,
         baseline: s.querySelectorAll('rect.baseline').length,
         alerts: s.querySelectorAll('line.alertmark:not(.other)').length })) : null;";
-    let charts = until(&c, "press-4's five windows drawn", &drawn.replace("WANT", "'5'")).await;
+    let charts = until(
+        &c,
+        "press-4's five windows drawn",
+        &drawn.replace("WANT", "'5'"),
+    )
+    .await;
     let charts = charts.as_array().unwrap();
-    let names: Vec<&Value> = trend["parameters"].as_array().unwrap().iter().map(|p| &p["name"]).collect();
+    let names: Vec<&Value> = trend["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| &p["name"])
+        .collect();
     assert_eq!(charts.len(), names.len());
     for (i, ch) in charts.iter().enumerate() {
         assert_eq!(&ch["param"], names[i]);
@@ -259,7 +303,10 @@ async fn the_pages_in_a_real_browser_show_the_fleet_and_update_live() {
             .iter()
             .filter(|a| a["parameter"] == ch["param"])
             .count();
-        assert_eq!(ch["alerts"], alerts, "{ch}: an alert mark per alert of the parameter");
+        assert_eq!(
+            ch["alerts"], alerts,
+            "{ch}: an alert mark per alert of the parameter"
+        );
         if ch["param"] == "kx" {
             assert!(alerts >= 1, "kx dropped 5 %: {trend}");
         }
@@ -287,23 +334,52 @@ async fn the_pages_in_a_real_browser_show_the_fleet_and_update_live() {
         )
         .await
         .unwrap();
-    assert_eq!(rest["kp"], orbit["keyphasor"].as_array().unwrap().len(), "{rest}");
+    assert_eq!(
+        rest["kp"],
+        orbit["keyphasor"].as_array().unwrap().len(),
+        "{rest}"
+    );
     assert_eq!(rest["orbit"], orbit["x_um"].as_array().unwrap().len());
-    assert_eq!((rest["xt"].clone(), rest["zt"].clone()), (json!(true), json!(true)));
+    assert_eq!(
+        (rest["xt"].clone(), rest["zt"].clone()),
+        (json!(true), json!(true))
+    );
     assert_eq!(rest["amp"], json!([5, 5]), "x and z, a point per window");
     assert_eq!(rest["phase"], json!([5, 5]));
     assert_eq!(rest["polar"], 10);
     assert_eq!(rest["rows"], 6);
-    assert!(rest["details"].as_str().unwrap().contains("modulating"), "{rest}");
+    assert!(
+        rest["details"].as_str().unwrap().contains("modulating"),
+        "{rest}"
+    );
     assert_eq!(rest["csv"], "/api/machines/press-4/trend.csv");
     assert_eq!(rest["json"], "/api/machines/press-4/summary");
-    let axes: Vec<&str> = rest["axes"].as_array().unwrap().iter().map(|t| t.as_str().unwrap()).collect();
-    for want in ["x [\u{b5}m]", "z [\u{b5}m]", "window number", "kx [N/m]", "amplitude [\u{b5}m pk]", "phase lag [deg]", "t [s]"] {
+    let axes: Vec<&str> = rest["axes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_str().unwrap())
+        .collect();
+    for want in [
+        "x [\u{b5}m]",
+        "z [\u{b5}m]",
+        "window number",
+        "kx [N/m]",
+        "amplitude [\u{b5}m pk]",
+        "phase lag [deg]",
+        "t [s]",
+    ] {
         assert!(axes.contains(&want), "axis {want:?} in {axes:?}");
     }
-    c.execute("window.__marker = 'machine page loaded once';", vec![]).await.unwrap();
+    c.execute("window.__marker = 'machine page loaded once';", vec![])
+        .await
+        .unwrap();
     if let Some(dir) = std::env::var_os("ROTORID_DASHBOARD_SCREENSHOTS") {
-        std::fs::write(PathBuf::from(&dir).join("machine.png"), c.screenshot().await.unwrap()).unwrap();
+        std::fs::write(
+            PathBuf::from(&dir).join("machine.png"),
+            c.screenshot().await.unwrap(),
+        )
+        .unwrap();
     }
 
     // a window published while both pages are open: both show it, neither reloads. The raw
@@ -343,7 +419,11 @@ async fn the_pages_in_a_real_browser_show_the_fleet_and_update_live() {
     .await;
     assert_eq!(after, "fleet page loaded once");
     if let Some(dir) = std::env::var_os("ROTORID_DASHBOARD_SCREENSHOTS") {
-        std::fs::write(PathBuf::from(&dir).join("fleet.png"), c.screenshot().await.unwrap()).unwrap();
+        std::fs::write(
+            PathBuf::from(&dir).join("fleet.png"),
+            c.screenshot().await.unwrap(),
+        )
+        .unwrap();
     }
     c.close().await.unwrap();
     drop(f);
