@@ -263,8 +263,9 @@ async function refresh(full) {
   if (busy) { again = true; return; }
   busy = true;
   try {
-    const newest = Math.max(-1, ...S.windows.keys(), ...S.oneX.keys());
-    // windows arrive out of order (workers run in parallel): ask again for the last 32
+    // results arrive out of order (workers run in parallel) and behind the raw windows:
+    // ask again for the 32 windows before the older of the newest result and 1X point
+    const newest = Math.min(Math.max(-1, ...S.windows.keys()), Math.max(-1, ...S.oneX.keys()));
     const after = full || newest < 0 ? '' : '?after=' + Math.max(0, newest - 32);
     if (full) { S.windows.clear(); S.oneX.clear(); }
     const [detail, trend] = await Promise.all([R.getJSON(base), R.getJSON(base + '/trend' + after)]);
@@ -302,3 +303,5 @@ R.events({
 });
 refresh(true);
 setInterval(headerRender, 1000);
+// and the whole trend once a minute, for a result that came later than that
+setInterval(() => refresh(true), 60000);
