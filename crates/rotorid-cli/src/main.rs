@@ -62,6 +62,7 @@ enum Command {
     Publish(commands::publish::PublishArgs),
     Worker(commands::worker::WorkerArgs),
     Fleet(commands::fleet::FleetArgs),
+    Dashboard(commands::dashboard::DashboardArgs),
 }
 
 fn main() {
@@ -79,6 +80,7 @@ fn main() {
         Command::Publish(args) => commands::publish::run(args),
         Command::Worker(args) => commands::worker::run(args),
         Command::Fleet(args) => commands::fleet::run(args),
+        Command::Dashboard(args) => commands::dashboard::run(args),
     };
     if let Err(err) = result {
         if err.is::<io::StdoutClosed>() {

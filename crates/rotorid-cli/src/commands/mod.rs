@@ -3,6 +3,7 @@
 pub mod analyze;
 pub mod balance;
 pub mod condition;
+pub mod dashboard;
 pub mod demo;
 pub mod fleet;
 pub mod identify;

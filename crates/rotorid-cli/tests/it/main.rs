@@ -4,6 +4,8 @@ mod common;
 
 mod analysis;
 mod daqmx;
+mod dashboard;
+mod dashboard_browser;
 mod demo;
 mod fleet;
 mod formats;
