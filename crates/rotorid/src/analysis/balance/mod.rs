@@ -48,7 +48,7 @@ pub use error::BalanceError;
 pub use influence::{KeyFit, NoiseSource};
 pub use multi::{
     balance, BalanceMethod, BalanceOptions, KeyResult, MultiPlaneBalance, PlaneCorrection,
-    PredictedResidual, SensorInfo, CONDITION_WARNING,
+    PredictedResidual, SensorInfo, CONDITION_WARNING, MISFIT_WARNING,
 };
 pub use plan::{plan_from_influence, plan_from_model, Trial, TrialPlan, DEFAULT_FRACTION};
 pub use report::{

@@ -18,6 +18,10 @@ use crate::analysis::modes::C64;
 /// error in the vectors can then move the correction by 10 % or more.
 pub const CONDITION_WARNING: f64 = 10.0;
 
+/// A fit whose residual RMS exceeds this fraction of the RMS size of its vectors gets a
+/// warning: the runs do not follow one linear model.
+pub const MISFIT_WARNING: f64 = 0.1;
+
 /// How the correction is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum BalanceMethod {
@@ -549,6 +553,28 @@ pub fn balance(
         notes.push(
             "with exactly as many calibration runs as unknowns and no standard deviations given, the fit has no residual to estimate the noise from: the influence coefficients and the correction have no standard deviation (give re_std, im_std or a std column, or one more run)".into(),
         );
+    }
+    // runs that do not fit one set of coefficients: a sign convention, an angle or a mass
+    // written wrong, or a rotor that is not linear
+    for (k, f) in pr.fits.iter().enumerate() {
+        let Some(f) = f else { continue };
+        if f.dof == 0 {
+            continue;
+        }
+        let size = (f
+            .runs
+            .iter()
+            .filter_map(|&r| a.vector[k][r].map(|v| v.0.norm_sqr()))
+            .sum::<f64>()
+            / f.runs.len() as f64)
+            .sqrt();
+        if f.residual_rms > MISFIT_WARNING * size {
+            let (s, v) = a.key(k);
+            warnings.push(format!(
+                "the calibration runs of sensor {s:?} at {v} rpm do not fit one set of influence coefficients: residual RMS {:.4} against vectors of RMS {size:.4} {}; check the phase convention (lag or lead), that the masses' angles are measured in the direction of rotation from the keyphasor mark, and the masses themselves",
+                f.residual_rms, a.sensors[a.sensor_of(k)].1
+            ));
+        }
     }
     let current_is_calibration = a.calibration.contains(&pr.current);
     if current_is_calibration {
