@@ -56,7 +56,7 @@ enum Command {
     /// Correction masses with their uncertainty: multi-plane, multi-speed influence
     /// coefficients (least squares or min-max, split into holes, trial planning), or one
     /// plane from an identified unbalance or two runs.
-    Balance(commands::balance::BalanceArgs),
+    Balance(Box<commands::balance::BalanceArgs>),
     /// The 1X vector of each probe of raw records (probes, keyphasor) as vectors.csv rows.
     Onex(commands::onex::OnexArgs),
     /// Turn a raw acquisition (probe volts, keyphasor, slow roll) into a response CSV.
@@ -77,7 +77,7 @@ fn main() {
         Command::Paper(args) => commands::paper::run(args),
         Command::Plot(args) => commands::plot::run(args),
         Command::Analyze(args) => commands::analyze::run(args),
-        Command::Balance(args) => commands::balance::run(args),
+        Command::Balance(args) => commands::balance::run(*args),
         Command::Onex(args) => commands::onex::run(args),
         Command::Condition(args) => commands::condition::run(args),
         Command::Inspect(args) => commands::inspect::run(args),

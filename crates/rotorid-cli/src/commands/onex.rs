@@ -154,7 +154,7 @@ pub fn vectors_of_raw(
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &w| {
                     (a.min(w), b.max(w))
                 });
-            if !(lo > 0.0) || hi > lo * (1.0 + ONE_SPEED) {
+            if lo.is_nan() || lo <= 0.0 || hi > lo * (1.0 + ONE_SPEED) {
                 bail!(
                     "{path}: the shaft turns at {:.1} to {:.1} rpm: a 1X vector needs one speed (within 2 %); give --speeds to pick speeds out of a run-up",
                     rad_per_s_to_rpm(lo),

@@ -147,6 +147,25 @@ fn header<R: Read>(
     }
 }
 
+/// Call `row` for every non-blank data row of `csv` (as long as the header `h`) with its
+/// line.
+fn each_row<R: Read>(
+    file: &str,
+    csv: &mut super::columns::CsvReader<R>,
+    h: &Header,
+    mut row: impl FnMut(&Record<'_>, u64) -> Result<(), CsvError>,
+) -> Result<(), CsvError> {
+    while let Some(rec) = next_record(file, csv)? {
+        let line = rec.line();
+        if rec.iter().all(|f| f.iter().all(u8::is_ascii_whitespace)) {
+            continue;
+        }
+        check_length(file, &rec, line, h)?;
+        row(&rec, line)?;
+    }
+    Ok(())
+}
+
 /// The header of `vectors.csv` (the column names every caller accepts).
 pub const VECTORS_HEADER: &str = "run,speed_rpm,sensor,re,im";
 /// The header of `masses.csv`.
@@ -241,13 +260,8 @@ pub fn read_vectors<R: Read>(
         }
     };
     let mut rows: Vec<VectorRow> = Vec::new();
-    while let Some(rec) = next_record(file, &mut csv)? {
-        let line = rec.line();
-        if rec.iter().all(|f| f.iter().all(u8::is_ascii_whitespace)) {
-            continue;
-        }
-        check_length(file, &rec, line, &h)?;
-        let run = text_field(file, &rec, line, base[0], "run")?;
+    each_row(file, &mut csv, &h, |rec, line| {
+        let run = text_field(file, rec, line, base[0], "run")?;
         let speed_rpm = ranged(
             file,
             &rec,
@@ -257,16 +271,16 @@ pub fn read_vectors<R: Read>(
             "finite and > 0 (rev/min)",
             |v| v > 0.0,
         )?;
-        let sensor = text_field(file, &rec, line, base[2], "sensor")?;
+        let sensor = text_field(file, rec, line, base[2], "sensor")?;
         let (re, im) = match form {
             Form::Cartesian(a, b) => (
-                ranged(file, &rec, line, a, "re", "finite", |_| true)?,
-                ranged(file, &rec, line, b, "im", "finite", |_| true)?,
+                ranged(file, rec, line, a, "re", "finite", |_| true)?,
+                ranged(file, rec, line, b, "im", "finite", |_| true)?,
             ),
             Form::Polar(a, b, p) => {
-                let amp = ranged(file, &rec, line, a, "amp", "finite and >= 0", |v| v >= 0.0)?;
-                let phase = ranged(file, &rec, line, b, "phase_deg", "finite (deg)", |_| true)?
-                    .to_radians();
+                let amp = ranged(file, rec, line, a, "amp", "finite and >= 0", |v| v >= 0.0)?;
+                let phase =
+                    ranged(file, rec, line, b, "phase_deg", "finite (deg)", |_| true)?.to_radians();
                 let sign = if p == Phase::Lag { -1.0 } else { 1.0 };
                 (amp * phase.cos(), sign * amp * phase.sin())
             }
@@ -302,12 +316,8 @@ pub fn read_vectors<R: Read>(
                     ("re_std", "im_std")
                 };
                 Some((
-                    ranged(file, &rec, line, a, names.0, "finite and >= 0", |v| {
-                        v >= 0.0
-                    })?,
-                    ranged(file, &rec, line, b, names.1, "finite and >= 0", |v| {
-                        v >= 0.0
-                    })?,
+                    ranged(file, rec, line, a, names.0, "finite and >= 0", |v| v >= 0.0)?,
+                    ranged(file, rec, line, b, names.1, "finite and >= 0", |v| v >= 0.0)?,
                 ))
             }
             None => None,
@@ -335,7 +345,8 @@ pub fn read_vectors<R: Read>(
             im,
             std,
         });
-    }
+        Ok(())
+    })?;
     if rows.is_empty() {
         return Err(CsvError::file(
             file,
@@ -351,14 +362,9 @@ pub fn read_masses<R: Read>(file: &str, input: R) -> Result<Vec<MassRow>, CsvErr
     let h = header(file, &mut csv, MASSES_HEADER)?;
     let cols = h.require(file, &["run", "plane", "mass_kg", "radius_m", "angle_deg"])?;
     let mut rows = Vec::new();
-    while let Some(rec) = next_record(file, &mut csv)? {
-        let line = rec.line();
-        if rec.iter().all(|f| f.iter().all(u8::is_ascii_whitespace)) {
-            continue;
-        }
-        check_length(file, &rec, line, &h)?;
-        let run = text_field(file, &rec, line, cols[0], "run")?;
-        let plane = text_field(file, &rec, line, cols[1], "plane")?;
+    each_row(file, &mut csv, &h, |rec, line| {
+        let run = text_field(file, rec, line, cols[0], "run")?;
+        let plane = text_field(file, rec, line, cols[1], "plane")?;
         let mass_kg = ranged(
             file,
             &rec,
@@ -406,7 +412,8 @@ pub fn read_masses<R: Read>(file: &str, input: R) -> Result<Vec<MassRow>, CsvErr
             radius_m,
             angle_deg,
         });
-    }
+        Ok(())
+    })?;
     if rows.is_empty() {
         return Err(CsvError::file(
             file,

@@ -30,8 +30,20 @@ struct Rig {
 
 impl Rig {
     fn new(seed: u64) -> Self {
+        Self::with_bow(seed, 0.0)
+    }
+
+    /// A rig whose vectors as found also hold a part no unbalance can cancel (a bow or
+    /// runout: `bow` times the unbalance response, at random phases), so that the best
+    /// correction leaves a residual.
+    fn with_bow(seed: u64, bow: f64) -> Self {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let mut z = |s: f64| C64::from_polar(s * rng.gen_range(0.5..1.5), rng.gen_range(0.0..6.28));
+        let mut z = |s: f64| {
+            C64::from_polar(
+                s * rng.gen_range(0.5..1.5),
+                rng.gen_range(0.0..std::f64::consts::TAU),
+            )
+        };
         // each disk acts most on its near bearing; the far one sees ~40 %
         let mut h = Vec::new();
         for (s, _) in SENSORS.iter().enumerate() {
@@ -45,7 +57,13 @@ impl Rig {
         }
         // as found: an unbalance of ~2e-4 kg m on each disk
         let u = [z(2e-4), z(2e-4)];
-        let a = h.iter().map(|r| r[0] * u[0] + r[1] * u[1]).collect();
+        let a = h
+            .iter()
+            .map(|r| {
+                let v = r[0] * u[0] + r[1] * u[1];
+                v + z(bow * v.norm())
+            })
+            .collect();
         Self { h, a }
     }
 
@@ -234,54 +252,73 @@ fn least_squares_equals_the_closed_form_with_and_without_weights() {
     assert!(after < 0.05 * before, "{after} vs {before}");
 }
 
-/// The fraction of `seeds` seeds for which each plane's correction error lies in its 95 %
-/// ellipse (2 degrees of freedom), with the error measured from the correction the noise-
-/// free data give.
-fn coverage(nruns: usize, stated: bool, method: BalanceMethod, seeds: u64) -> f64 {
-    let rig = Rig::new(11);
-    let sigma = 1.0;
+/// Over `seeds` noise seeds: the fraction of the planes' correction errors (from the
+/// correction the noise-free data give) inside their 95 % ellipses (2 degrees of
+/// freedom), and the ratio of the errors' mean square to the mean stated variance
+/// (trace of each plane's 2x2 covariance).
+fn coverage(
+    nruns: usize,
+    stated: bool,
+    method: BalanceMethod,
+    current: &str,
+    sigma: f64,
+    seeds: u64,
+) -> (f64, f64) {
+    let rig = Rig::with_bow(11, 0.2);
     let clean = {
         let (v, m) = data(&rig, nruns, 0.0, false, &mut ChaCha8Rng::seed_from_u64(0));
-        let mut o = opts("asfound");
+        let mut o = opts(current);
         o.method = method;
         correction(&balance(&v, &m, &o).unwrap())
     };
-    let mut inside = 0;
-    let mut total = 0;
+    let (mut inside, mut total) = (0, 0);
+    let (mut err2, mut var) = (0.0, 0.0);
     for seed in 0..seeds {
         let mut rng = ChaCha8Rng::seed_from_u64(1000 + seed);
         let (v, m) = data(&rig, nruns, sigma, stated, &mut rng);
-        let mut o = opts("asfound");
+        let mut o = opts(current);
         o.method = method;
         let b = balance(&v, &m, &o).unwrap();
         for (p, c) in b.corrections.iter().enumerate() {
             let d = c.unbalance - clean[p];
-            let inv = c.covariance.unwrap().try_inverse().unwrap();
+            let cov = c.covariance.unwrap();
+            let inv = cov.try_inverse().unwrap();
             let m2 = d.re * (inv[(0, 0)] * d.re + inv[(0, 1)] * d.im)
                 + d.im * (inv[(1, 0)] * d.re + inv[(1, 1)] * d.im);
             total += 1;
             if m2 < 5.991 {
                 inside += 1;
             }
+            err2 += d.norm_sqr();
+            var += cov.trace();
         }
     }
-    inside as f64 / total as f64
+    (inside as f64 / total as f64, err2 / var)
 }
 
 #[test]
 fn the_stated_std_covers_the_scatter_over_noise_seeds() {
-    // the vectors' noise stated (4 runs: the fit is exactly determined in all but noise)
-    let c = coverage(4, true, BalanceMethod::LeastSquares, 300);
-    println!("coverage, least squares, noise stated, 4 runs: {c:.3}");
-    assert!((0.90..=0.99).contains(&c), "{c}");
+    // the vectors' noise (1 um on ~100 um) stated, 4 runs; the current run one of them
+    // (its vector correlates with the fitted coefficients) and the run with masses on both
+    // planes
+    for current in ["asfound", "t12"] {
+        let (c, r) = coverage(4, true, BalanceMethod::LeastSquares, current, 1.0, 300);
+        println!("least squares, noise stated, 4 runs, current {current}: coverage {c:.3}, mean square error / stated variance {r:.3}");
+        assert!((0.90..=0.99).contains(&c), "{c}");
+        assert!((0.8..=1.25).contains(&r), "{r}");
+    }
     // the noise from the residuals of 8 runs (10 degrees of freedom per key)
-    let c = coverage(8, false, BalanceMethod::LeastSquares, 300);
-    println!("coverage, least squares, noise from residuals, 8 runs: {c:.3}");
+    let (c, r) = coverage(8, false, BalanceMethod::LeastSquares, "asfound", 1.0, 300);
+    println!("least squares, noise from residuals, 8 runs: coverage {c:.3}, ratio {r:.3}");
     assert!((0.90..=0.99).contains(&c), "{c}");
-    // min-max (derivatives by central differences of the solver)
-    let c = coverage(4, true, BalanceMethod::MinMax, 100);
-    println!("coverage, min-max, noise stated, 4 runs: {c:.3}");
-    assert!((0.90..=0.995).contains(&c), "{c}");
+    assert!((0.8..=1.25).contains(&r), "{r}");
+    // min-max: derivatives by central differences of the polished solution; the rig's bow
+    // leaves a residual (~20 um) that no correction removes, so the optimum's active set
+    // stays under the noise and the first-order covariance is the scatter's
+    let (c, r) = coverage(4, true, BalanceMethod::MinMax, "asfound", 1.0, 100);
+    println!("min-max, noise stated, 4 runs: coverage {c:.3}, ratio {r:.3}");
+    assert!((0.90..=0.99).contains(&c), "{c}");
+    assert!((0.7..=1.3).contains(&r), "{r}");
 }
 
 #[test]
@@ -309,7 +346,12 @@ fn min_max_lowers_the_peak_and_meets_limits() {
     o.limits = vec![("B1X".into(), 0.5 * b1x)];
     let lim = balance(&vectors, &masses, &o).unwrap();
     for r in lim.residual.iter().filter(|r| r.sensor == 0) {
-        assert!(r.after.norm() <= 0.5 * b1x * (1.0 + 1e-7));
+        assert!(
+            r.after.norm() <= 0.5 * b1x * (1.0 + 1e-7),
+            "{} > {}",
+            r.after.norm(),
+            0.5 * b1x
+        );
     }
     assert!(peak(&lim) >= peak(&mm) * (1.0 - 1e-8));
     // the same limit with least squares is a warning, not a constraint

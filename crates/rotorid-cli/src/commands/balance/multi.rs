@@ -100,13 +100,10 @@ fn options(args: &BalanceArgs, current: String) -> anyhow::Result<BalanceOptions
             }
         }
     }
-    let mass_set = match &args.mass_set {
-        Some(m) => Some(MassSet {
-            masses: m.clone(),
-            per_hole: args.per_hole,
-        }),
-        None => None,
-    };
+    let mass_set = args.mass_set.as_ref().map(|m| MassSet {
+        masses: m.clone(),
+        per_hole: args.per_hole,
+    });
     Ok(BalanceOptions {
         current,
         speeds_rpm: args.speeds.clone(),

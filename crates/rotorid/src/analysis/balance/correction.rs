@@ -25,7 +25,8 @@
 //! ```
 //!
 //! for a change of row h_k or of V_k; for min-max it is taken by central differences of the
-//! solver (steps of 1e-5 of the largest |H| or |V|; the solution is piecewise smooth).
+//! solver (steps of 1e-6 of the largest |H| or |V|, of the solution polished on its active
+//! set; the solution is piecewise smooth).
 //! Cov(C) = J Cov(q) J^T and likewise for r. Reference: Casella & Berger, *Statistical
 //! Inference*, 2nd ed., 2002, sec. 5.5.4.
 
@@ -37,6 +38,9 @@ use crate::analysis::modes::C64;
 /// Smallest singular value accepted, relative to the largest, of the weighted influence
 /// matrix.
 const RANK_TOLERANCE: f64 = 1e-10;
+
+/// Relative step of the central differences of the min-max correction.
+const FD_STEP: f64 = 1e-6;
 
 /// The correction problem (module doc): one row per key with a current vector.
 #[derive(Debug, Clone)]
@@ -170,17 +174,14 @@ fn ls_jacobian(p: &Problem, c: &DVector<C64>, r: &DVector<C64>) -> Option<DMatri
 }
 
 /// Jacobian of (Re C, Im C) over q by central differences of `solve` (min-max).
-fn fd_jacobian(
-    p: &Problem,
-    solve: &dyn Fn(&Problem) -> Result<DVector<C64>, BalanceError>,
-) -> Result<DMatrix<f64>, BalanceError> {
+fn fd_jacobian(p: &Problem, solve: Solver<'_>) -> Result<DMatrix<f64>, BalanceError> {
     let np = p.h.ncols();
     let hmax = p.h.iter().fold(0.0f64, |m, z| m.max(z.norm()));
     let vmax = p.v.iter().fold(0.0f64, |m, z| m.max(z.norm()));
     let mut jac = DMatrix::<f64>::zeros(2 * np, nq(p));
     for j in 0..nq(p) {
         let (k, plane, d) = direction(p, j);
-        let step = 1e-5 * if plane.is_some() { hmax } else { vmax };
+        let step = FD_STEP * if plane.is_some() { hmax } else { vmax };
         if step <= 0.0 {
             continue;
         }
@@ -233,7 +234,7 @@ fn propagate(p: &Problem, jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     for (k, block) in p.cov.iter().enumerate() {
         let jk = jac.columns(k * per, per);
         match block {
-            Some(s) => out += &jk * s * jk.transpose(),
+            Some(s) => out += jk * s * jk.transpose(),
             None if jk.iter().all(|v| *v == 0.0) => {}
             None => return None,
         }
@@ -241,11 +242,12 @@ fn propagate(p: &Problem, jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     out.iter().all(|v| v.is_finite()).then_some(out)
 }
 
-/// Solve `p` with `method` and propagate the uncertainty (module doc).
-pub(crate) fn solve(
-    p: &Problem,
-    minmax: Option<&dyn Fn(&Problem) -> Result<DVector<C64>, BalanceError>>,
-) -> Result<Solved, BalanceError> {
+/// A solver of a correction problem (the min-max one).
+pub(crate) type Solver<'a> = &'a dyn Fn(&Problem) -> Result<DVector<C64>, BalanceError>;
+
+/// Solve `p` by least squares, or by `minmax` when given, and propagate the uncertainty
+/// (module doc).
+pub(crate) fn solve(p: &Problem, minmax: Option<Solver<'_>>) -> Result<Solved, BalanceError> {
     let c = match minmax {
         Some(f) => f(p)?,
         None => least_squares(p)?,

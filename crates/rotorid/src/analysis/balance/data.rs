@@ -75,6 +75,9 @@ impl MassInput {
     }
 }
 
+/// A measured vector \[sensor unit\] and its covariance when known.
+pub(crate) type Measured = (C64, Option<Matrix2<f64>>);
+
 /// The vectors and masses checked and indexed (module doc).
 #[derive(Debug, Clone)]
 pub(crate) struct Assembled {
@@ -94,7 +97,7 @@ pub(crate) struct Assembled {
     /// The radii of the non-zero masses of each plane \[m\].
     pub radii: Vec<Vec<f64>>,
     /// `vector[key][run]`: the vector and its covariance, key = sensor * speeds + speed.
-    pub vector: Vec<Vec<Option<(C64, Option<Matrix2<f64>>)>>>,
+    pub vector: Vec<Vec<Option<Measured>>>,
 }
 
 impl Assembled {

@@ -11,7 +11,8 @@
 //! s_0 >= sqrt(s_1^2 + s_2^2), s = (t, w Re r_k, w Im r_k) affine in x = (t, Re C_1, Im C_1,
 //! ...). Solved by Clarabel (an interior-point conic solver, oxfordcontrol/Clarabel.rs), the
 //! data scaled to O(1) first (vectors by their largest magnitude, C by the ratio of that to
-//! the largest |h|) and the tolerances tightened to 1e-10.
+//! the largest |h|) and the tolerances tightened to 1e-10; the solution is then polished by
+//! Newton's method on the KKT equations of its active set (`polish`), to rounding.
 //!
 //! When the limits cannot all be met the solver reports primal infeasibility; the problem
 //! minimise rho subject to |r_k| <= rho L_k (the limited keys only) then gives by how much
@@ -21,9 +22,7 @@
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
-#[cfg(test)]
-use nalgebra::DMatrix;
-use nalgebra::{Complex, DVector};
+use nalgebra::{Complex, DMatrix, DVector};
 
 use super::correction::Problem;
 use super::error::BalanceError;
@@ -54,12 +53,14 @@ fn solve_socp(
     let cones: Vec<SupportedConeT<f64>> = (0..cones)
         .map(|_| SupportedConeT::SecondOrderConeT(3))
         .collect();
-    let mut settings = DefaultSettings::<f64>::default();
-    settings.verbose = false;
-    settings.tol_gap_abs = TOLERANCE;
-    settings.tol_gap_rel = TOLERANCE;
-    settings.tol_feas = TOLERANCE;
-    settings.max_iter = 200;
+    let settings = DefaultSettings::<f64> {
+        verbose: false,
+        tol_gap_abs: TOLERANCE,
+        tol_gap_rel: TOLERANCE,
+        tol_feas: TOLERANCE,
+        max_iter: 200,
+        ..DefaultSettings::default()
+    };
     let mut solver =
         DefaultSolver::new(&p, &q, &a, &b, &cones, settings).map_err(|e| BalanceError::Solver {
             status: e.to_string(),
@@ -96,10 +97,8 @@ fn cone_rows(
     k: usize,
     w: f64,
     bound: Option<f64>,
-    vs: f64,
-    cs: f64,
-    rows: &mut Vec<Vec<f64>>,
-    b: &mut Vec<f64>,
+    (vs, cs): (f64, f64),
+    (rows, b): (&mut Vec<Vec<f64>>, &mut Vec<f64>),
 ) {
     let np = p.h.ncols();
     let mut r0 = vec![0.0; 1 + 2 * np];
@@ -139,21 +138,166 @@ pub(crate) fn min_max(
     let mut b = Vec::new();
     let mut cones = 0;
     for i in 0..k {
-        cone_rows(p, i, p.w[i], None, vs, cs, &mut rows, &mut b);
+        cone_rows(p, i, p.w[i], None, (vs, cs), (&mut rows, &mut b));
         cones += 1;
     }
     for (i, l) in limits.iter().enumerate() {
         if let Some(l) = l {
-            cone_rows(p, i, 1.0, Some(l / vs), vs, cs, &mut rows, &mut b);
+            cone_rows(p, i, 1.0, Some(l / vs), (vs, cs), (&mut rows, &mut b));
             cones += 1;
         }
     }
     match solve_socp(1 + 2 * np, rows, b, cones, "the min-max correction")? {
-        Outcome::Solved(x) => Ok(DVector::from_fn(np, |q, _| {
-            Complex::new(x[1 + 2 * q], x[2 + 2 * q]) * cs
-        })),
+        Outcome::Solved(x) => {
+            let c = DVector::from_fn(np, |q, _| Complex::new(x[1 + 2 * q], x[2 + 2 * q]) * cs);
+            Ok(polish(p, limits, &c).unwrap_or(c))
+        }
         Outcome::Infeasible => Err(infeasible(p, limits, names)?),
     }
+}
+
+/// Relative closeness of a constraint to its bound that counts it as active.
+const ACTIVE: f64 = 1e-5;
+
+/// The interior-point solution polished on its active set: Newton on the KKT equations
+///
+/// ```text
+/// sum_k lambda_k grad_c g_k = 0,   1 - 2 t sum_(k bounded by t) lambda_k = 0,   g_k = 0 (k active)
+/// g_k = w_k^2 |r_k|^2 - t^2  (or |r_k|^2 - L_k^2 for a limit)
+/// ```
+///
+/// in scaled units, the multipliers started from the least-squares solution of the
+/// stationarity equations at the solver's point. The solver stops at a tolerance whose
+/// effect on C is far larger than rounding (the optimum is flat along the active set's
+/// tangents); the polished C is accurate to rounding, which the central differences of the
+/// standard deviations need. `None` (the solver's C stands) when a multiplier is not
+/// positive (a degenerate active set) or Newton does not converge to rounding.
+fn polish(p: &Problem, limits: &[Option<f64>], c0: &DVector<C64>) -> Option<DVector<C64>> {
+    let (k, np) = p.h.shape();
+    let (vs, cs) = scales(p);
+    // units: C by cs, vectors by the largest weighted residual at the solver's point, so
+    // that t is 1 and every equation is O(1)
+    let rw = (0..k)
+        .map(|i| p.w[i] * (p.v[i] + (p.h.row(i) * c0)[0]).norm())
+        .fold(0.0f64, f64::max);
+    if !(rw > 0.0 && rw.is_finite()) {
+        return None;
+    }
+    let vs = vs.min(rw);
+    let h = p.h.map(|z| z * (cs / vs));
+    let v = p.v.map(|z| z / vs);
+    let r_of = |c: &DVector<C64>| &v + &h * c;
+    let c_start = c0.map(|z| z / cs);
+    let r0 = r_of(&c_start);
+    let t0 = (0..k).map(|i| p.w[i] * r0[i].norm()).fold(0.0f64, f64::max);
+    // active constraints: (key, Some(limit) or None for t)
+    let mut active: Vec<(usize, Option<f64>)> = (0..k)
+        .filter(|&i| p.w[i] * r0[i].norm() >= t0 * (1.0 - ACTIVE))
+        .map(|i| (i, None))
+        .collect();
+    for (i, l) in limits.iter().enumerate() {
+        if let Some(l) = l {
+            let l = l / vs;
+            if r0[i].norm() >= l * (1.0 - ACTIVE) {
+                active.push((i, Some(l)));
+            }
+        }
+    }
+    let n = 2 * np + 1;
+    let na = active.len();
+    // the real Jacobian of r_i over (Re c_1, Im c_1, ...)
+    let jr = |i: usize| {
+        let mut m = DMatrix::<f64>::zeros(2, 2 * np);
+        for q in 0..np {
+            let z = h[(i, q)];
+            m[(0, 2 * q)] = z.re;
+            m[(0, 2 * q + 1)] = -z.im;
+            m[(1, 2 * q)] = z.im;
+            m[(1, 2 * q + 1)] = z.re;
+        }
+        m
+    };
+    let scale_of = |i: usize, l: Option<f64>| if l.is_some() { 1.0 } else { p.w[i] * p.w[i] };
+    // z = (c (2P), t, lambda (na))
+    let residual = |z: &DVector<f64>| -> (DVector<f64>, DMatrix<f64>) {
+        let c = DVector::from_fn(np, |q, _| Complex::new(z[2 * q], z[2 * q + 1]));
+        let t = z[2 * np];
+        let r = r_of(&c);
+        let mut f = DVector::<f64>::zeros(n + na);
+        let mut jac = DMatrix::<f64>::zeros(n + na, n + na);
+        f[2 * np] = 1.0;
+        for (a, &(i, l)) in active.iter().enumerate() {
+            let s = scale_of(i, l);
+            let j = jr(i);
+            let rv = nalgebra::Vector2::new(r[i].re, r[i].im);
+            let grad = j.transpose() * rv * (2.0 * s);
+            let lam = z[n + a];
+            for x in 0..2 * np {
+                f[x] += lam * grad[x];
+                jac[(x, n + a)] = grad[x];
+                jac[(n + a, x)] = grad[x];
+            }
+            let hess = j.transpose() * &j * (2.0 * s * lam);
+            for x in 0..2 * np {
+                for y in 0..2 * np {
+                    jac[(x, y)] += hess[(x, y)];
+                }
+            }
+            match l {
+                None => {
+                    f[2 * np] -= 2.0 * t * lam;
+                    jac[(2 * np, 2 * np)] -= 2.0 * lam;
+                    jac[(2 * np, n + a)] = -2.0 * t;
+                    jac[(n + a, 2 * np)] = -2.0 * t;
+                    f[n + a] = s * r[i].norm_sqr() - t * t;
+                }
+                Some(lim) => f[n + a] = r[i].norm_sqr() - lim * lim,
+            }
+        }
+        (f, jac)
+    };
+    // multipliers from the stationarity equations at the start
+    let mut z = DVector::<f64>::zeros(n + na);
+    for q in 0..np {
+        z[2 * q] = c_start[q].re;
+        z[2 * q + 1] = c_start[q].im;
+    }
+    z[2 * np] = t0;
+    let (_, jac0) = residual(&z);
+    let a = jac0.view((0, n), (n, na)).into_owned();
+    let mut rhs = DVector::<f64>::zeros(n);
+    rhs[2 * np] = -1.0;
+    let lam = a.svd(true, true).solve(&rhs, 1e-12).ok()?;
+    if lam.iter().any(|&x| x.is_nan() || x <= 0.0) {
+        return None;
+    }
+    z.view_mut((n, 0), (na, 1)).copy_from(&lam);
+    for _ in 0..30 {
+        let (f, jac) = residual(&z);
+        let step = jac.lu().solve(&(-&f))?;
+        z += &step;
+        // converged: the step is at rounding of the unknowns
+        if step.amax() <= 1e-13 * z.amax() {
+            let (f, _) = residual(&z);
+            let c = DVector::from_fn(np, |q, _| Complex::new(z[2 * q], z[2 * q + 1]) * cs);
+            let moved = (&c - c0).norm() / c0.norm().max(f64::MIN_POSITIVE);
+            // and no constraint left out of the active set is violated
+            let r = r_of(&DVector::from_fn(np, |q, _| {
+                Complex::new(z[2 * q], z[2 * q + 1])
+            }));
+            let t = z[2 * np];
+            let feasible = (0..k).all(|i| p.w[i] * r[i].norm() <= t * (1.0 + 1e-9))
+                && limits
+                    .iter()
+                    .enumerate()
+                    .all(|(i, l)| l.is_none_or(|l| r[i].norm() <= l / vs * (1.0 + 1e-9)));
+            let fine = feasible && f.amax() < 1e-9 * (1.0 + z.amax());
+            // the polished point is the solver's, refined: a large move is a wrong active
+            // set, and every multiplier stays positive
+            return (fine && moved < 1e-3 && z.rows(n, na).iter().all(|&x| x > 0.0)).then_some(c);
+        }
+    }
+    None
 }
 
 /// The error of limits that cannot be met, with the factor by which the best correction
@@ -170,7 +314,7 @@ fn infeasible(
     let mut cones = 0;
     for (i, l) in limits.iter().enumerate() {
         if let Some(l) = l {
-            cone_rows(p, i, 1.0 / (l / vs), None, vs, cs, &mut rows, &mut b);
+            cone_rows(p, i, 1.0 / (l / vs), None, (vs, cs), (&mut rows, &mut b));
             cones += 1;
         }
     }

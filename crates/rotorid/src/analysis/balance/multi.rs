@@ -604,7 +604,7 @@ pub fn balance(
         }
     }
     if opts.method == BalanceMethod::MinMax && solved.cov_c.is_some() {
-        notes.push("the min-max correction's standard deviations are first-order (derivatives by central differences of the solver): where the largest residual switches between sensors they are indicative".into());
+        notes.push("the min-max correction's standard deviations are first-order (derivatives by central differences of the polished solution): they hold while the set of sensors at the largest residual does not change with the noise, and overstate the scatter when the predicted residuals are at the noise level".into());
     }
     let fits = (0..a.keys())
         .filter_map(|k| {

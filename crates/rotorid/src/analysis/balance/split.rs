@@ -123,7 +123,7 @@ fn check(plane: &str, angles: &[f64], set: Option<&MassSet>) -> Result<(), Balan
     for (i, a) in angles.iter().enumerate() {
         for (j, b) in angles.iter().enumerate().skip(i + 1) {
             let d = wrap(a - b);
-            if d < 1e-9 || d > std::f64::consts::TAU - 1e-9 {
+            if !(1e-9..=std::f64::consts::TAU - 1e-9).contains(&d) {
                 return Err(err(format!(
                     "holes {} and {} are both at {:.6} deg: every hole needs its own angle",
                     i + 1,
@@ -199,7 +199,7 @@ fn continuous(u: C64, radius: f64, angles: &[f64]) -> Vec<SplitMass> {
     // on a hole
     for (j, &t) in angles.iter().enumerate() {
         let d = wrap(beta - t);
-        if d < ON_HOLE || d > std::f64::consts::TAU - ON_HOLE {
+        if !(ON_HOLE..=std::f64::consts::TAU - ON_HOLE).contains(&d) {
             return vec![mass(j, t, size)];
         }
     }
