@@ -8,6 +8,7 @@ pub mod demo;
 pub mod fleet;
 pub mod identify;
 pub mod inspect;
+pub mod onex;
 pub mod paper;
 pub mod plot;
 pub mod publish;

@@ -3,6 +3,7 @@
 mod common;
 
 mod analysis;
+mod balance;
 mod daqmx;
 mod dashboard;
 mod dashboard_browser;

@@ -18,6 +18,12 @@ Quick start::
 
 Every computation runs in the Rust library with the GIL released; a record gives the
 same result (``res.to_dict()``) as ``rotorid identify --summary`` on the same file.
+
+Balancing (influence coefficients of many planes, sensors and speeds)::
+
+    b = rotorid.balance(vectors_df, masses_df, current="asfound", holes={"disk1": 12})
+    b.corrections                                      # mass_kg, angle_deg and their std
+    b.residual, b.influence, b.split                   # DataFrames; b.to_dict() == balance.json
 """
 
 from __future__ import annotations
@@ -30,16 +36,21 @@ import pandas as pd
 
 from . import _rotorid
 from ._rotorid import ESTIMATE_COLUMNS, METHODS, UNKNOWNS, Scenario
+from ._balance import Balance, TrialPlan, balance, plan_trials
 from ._result import Identification
 
 __all__ = [
     "ESTIMATE_COLUMNS",
     "METHODS",
     "UNKNOWNS",
+    "Balance",
     "Identification",
     "Scenario",
     "Session",
+    "TrialPlan",
+    "balance",
     "identify",
+    "plan_trials",
     "read",
     "read_blocks",
     "simulate",

@@ -6,16 +6,24 @@ from typing import Any, Iterator, Mapping, Sequence, final
 import numpy as np
 import pandas as pd
 
+from ._balance import Balance as Balance
+from ._balance import TrialPlan as TrialPlan
+from ._balance import balance as balance
+from ._balance import plan_trials as plan_trials
 from ._result import Identification as Identification
 
 __all__ = [
     "ESTIMATE_COLUMNS",
     "METHODS",
     "UNKNOWNS",
+    "Balance",
     "Identification",
     "Scenario",
     "Session",
+    "TrialPlan",
+    "balance",
     "identify",
+    "plan_trials",
     "read",
     "read_blocks",
     "simulate",

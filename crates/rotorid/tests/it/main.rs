@@ -8,6 +8,7 @@ mod acquisition;
 mod adequacy;
 mod algebraic_windows;
 mod analysis;
+mod balance;
 mod cross_algebraic;
 mod cross_modulating;
 mod cross_reference;
