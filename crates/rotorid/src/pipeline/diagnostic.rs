@@ -192,6 +192,16 @@ pub enum Finding {
         /// Why.
         reason: String,
     },
+    /// Time stamps off the fitted grid by more than the time tolerance, within the
+    /// rounding of the decimals they are printed with (module `grid`): accepted (a note).
+    TimeStampsRounded {
+        /// One unit of the stamps' last decimal \[s\].
+        resolution_s: f64,
+        /// The largest deviation of a stamp from the fitted grid \[s\].
+        max_deviation_s: f64,
+        /// The fitted sampling period \[s\].
+        dt_s: f64,
+    },
 }
 
 /// A finding with its severity and message (module doc).
@@ -214,6 +224,14 @@ impl Diagnostic {
             finding,
             severity: Severity::Warning,
             message,
+        }
+    }
+
+    /// The note (worth knowing, the numbers stand) of one of the pipeline's findings.
+    pub(crate) fn note(finding: Finding) -> Self {
+        Self {
+            severity: Severity::Note,
+            ..Self::new(finding)
         }
     }
 
@@ -407,6 +425,17 @@ fn message(f: &Finding) -> String {
         Finding::CrbUnavailable { reason } => {
             format!("the Cramer-Rao bound was not computed: {reason}")
         }
+        Finding::TimeStampsRounded {
+            resolution_s,
+            max_deviation_s,
+            dt_s,
+        } => format!(
+            "the time stamps are printed to {resolution_s:e} s: they are up to \
+             {max_deviation_s:.2e} s ({:.3} dt) off the uniform grid fitted over all of them \
+             (dt = {dt_s:e} s), which that rounding explains; the identification uses the \
+             grid",
+            max_deviation_s / dt_s
+        ),
         // The refinement's findings are made from its warnings (`From<&Warning>`), which
         // carry their own sentences; this is only their fallback.
         other => format!("{other:?}"),

@@ -40,7 +40,10 @@ pub use adequacy::{
 pub use consistency::SPEED_FACTOR_TOLERANCE;
 pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};
 pub use error::PipelineError;
-pub use grid::{RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE, SNAP_DT, SNAP_T0};
+pub use grid::{
+    rounding_allowance, stamp_decimals, RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE,
+    MAX_ROUNDING_ALLOWANCE, MAX_STAMP_DECIMALS, SNAP_DT, SNAP_T0,
+};
 pub use identification::{
     AlgebraicDetail, Covariance, CrbAt, FinalEstimate, Identification, ModulatingDetail, Noise,
     NoiseSource, ParameterResult, RecordInfo, RefineDetail, RotorSummary, Start, StartSource,
@@ -83,8 +86,11 @@ pub fn identify(
     knowledge: &Knowledge,
     method: &Method,
 ) -> Result<Identification, PipelineError> {
+    let rounded = record.grid().rounding_note();
     if let Method::Refine(s) = method {
-        return refine_run::run(record, knowledge, s);
+        let mut ident = refine_run::run(record, knowledge, s)?;
+        ident.diagnostics.extend(rounded);
+        return Ok(ident);
     }
     let profile = match record.speed() {
         Speed::Profile(p) => Some(*p),
@@ -109,12 +115,23 @@ pub fn identify(
         session.push(&s, &mut ignore)?;
     }
     let mut ident = session.finish(&mut ignore)?;
+    ident.diagnostics.extend(rounded);
     ident.record = RecordInfo {
         max_time_deviation_s: record.grid().max_deviation,
         speed: record.speed_source(),
         ..ident.record
     };
     Ok(ident)
+}
+
+/// The note of a record whose stamps were accepted because rounding to `resolution` \[s\]
+/// explains their largest deviation `max_deviation` \[s\] from the grid of period `dt`.
+pub(crate) fn rounded_stamps_note(resolution: f64, max_deviation: f64, dt: f64) -> Diagnostic {
+    Diagnostic::note(Finding::TimeStampsRounded {
+        resolution_s: resolution,
+        max_deviation_s: max_deviation,
+        dt_s: dt,
+    })
 }
 
 /// Withhold every value of `ident` (after a finding that invalidates the input).

@@ -154,6 +154,8 @@ pub struct Session {
     t_first: f64,
     t_last: f64,
     max_deviation: f64,
+    /// Whether a stamp needed the rounding allowance (module `grid`).
+    rounded: bool,
     keep: bool,
     speed_check: super::consistency::SpeedConsistency,
     magnitudes: super::plausibility::Magnitudes,
@@ -201,6 +203,7 @@ impl Session {
             t_first: f64::NAN,
             t_last: f64::NAN,
             max_deviation: 0.0,
+            rounded: false,
             keep: false,
             speed_check: Default::default(),
             magnitudes: Default::default(),
@@ -333,11 +336,14 @@ impl Session {
                 self.running.push(index, t)?;
                 // Check against the given grid, or the fit of every stamp so far.
                 let deviation = match self.timing {
-                    Timing::Grid { grid, .. } => Some(grid.check(index, t, tolerance)?),
-                    Timing::Fit { .. } => self.running.check_newest(tolerance)?,
+                    Timing::Grid { grid, .. } => {
+                        Some(grid.check_rounded(index, t, tolerance, self.running.resolution())?)
+                    }
+                    Timing::Fit { .. } => self.running.check_newest_rounded(tolerance)?,
                 };
-                if let Some(d) = deviation {
+                if let Some((d, rounded)) = deviation {
                     self.max_deviation = self.max_deviation.max(d);
+                    self.rounded |= rounded;
                 }
                 t
             }
@@ -499,6 +505,9 @@ impl Session {
             },
         };
         let drift = self.drift(grid);
+        let rounded = self.rounded.then(|| {
+            super::rounded_stamps_note(self.running.resolution(), self.max_deviation, grid.dt)
+        });
         let mut ident = match self.engine.take().expect("started") {
             Engine::Algebraic {
                 id,
@@ -552,10 +561,12 @@ impl Session {
                 let rec = self.record(kept, grid)?;
                 let mut ident = super::refine_run::run(&rec, &self.knowledge, s)?;
                 ident.diagnostics.extend(self.speed_check.profile_finding());
+                ident.diagnostics.extend(rounded);
                 return Ok(ident);
             }
         };
         ident.diagnostics.extend(drift);
+        ident.diagnostics.extend(rounded);
         ident.diagnostics.extend(self.magnitudes.findings());
         super::apply_speed_check(&mut ident, &self.speed_check);
         ident.diagnostics.extend(self.speed_check.profile_finding());

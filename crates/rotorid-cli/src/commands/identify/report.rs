@@ -1,16 +1,16 @@
 //! The few lines `rotorid identify` prints on stderr for a person: per parameter the
 //! value, the truth and error when known, and (algebraic) the identification time or
 //! (modulating, refine) the standard error and Cramer-Rao bound; then every diagnostic as
-//! a `warning:` line (printed even with `--quiet`).
+//! a `warning:` line, or a `note:` line for a note (printed even with `--quiet`).
 
 use std::fmt::Write as _;
 
-use rotorid::pipeline::{CrbAt, Identification, MethodName, StartSource};
+use rotorid::pipeline::{CrbAt, Identification, MethodName, Severity, StartSource};
 
 use crate::io::number::format_sig;
 
 /// The `warning:` lines: a prominent one when refine says the record does not determine
-/// the unknowns, then one per diagnostic.
+/// the unknowns, then one per diagnostic (`note:` for a note).
 pub(crate) fn warning_lines(r: &Identification) -> Vec<String> {
     let mut out = Vec::new();
     if !r.identifiable() {
@@ -21,11 +21,10 @@ pub(crate) fn warning_lines(r: &Identification) -> Vec<String> {
                 .to_owned(),
         );
     }
-    out.extend(
-        r.diagnostics
-            .iter()
-            .map(|d| format!("warning: {}", d.message)),
-    );
+    out.extend(r.diagnostics.iter().map(|d| match d.severity {
+        Severity::Warning => format!("warning: {}", d.message),
+        Severity::Note => format!("note: {}", d.message),
+    }));
     out
 }
 
