@@ -57,8 +57,8 @@ pub use plausibility::{DISPLACEMENT_MAX_M, DISPLACEMENT_MIN_M, NOISE_TO_SIGNAL_M
 pub use record::{rebased, Record, Speed, SpeedSource, CONSTANT_PHI_TOLERANCE};
 pub use refine_run::REFINE_MIN_SAMPLES;
 pub use session::{
-    Sample, SampleEstimate, Session, Timing, ALGEBRAIC_MIN_SAMPLES, DEFAULT_GRID_HEAD,
-    GRID_DRIFT_LIMIT,
+    Sample, SampleEstimate, Session, Timing, ALGEBRAIC_ADEQUACY_SAMPLES, ALGEBRAIC_MIN_SAMPLES,
+    DEFAULT_GRID_HEAD, GRID_DRIFT_LIMIT, MODULATING_CRB_MAX_SAMPLES,
 };
 pub use start::ALGEBRAIC_START_S;
 
