@@ -12,6 +12,7 @@ mod identify;
 mod modulating;
 mod paper;
 mod plot;
+mod raw_records;
 mod refine;
 mod safety;
 mod scenario;

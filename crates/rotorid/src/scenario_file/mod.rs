@@ -410,10 +410,25 @@ impl ScenarioSpec {
         }
     }
 
+    /// The rotor of a complete `[rotor]` (all nine keys), whatever else the scenario
+    /// lacks (a raw acquisition's scenario has no `[speed]`: its keyphasor gives the
+    /// speed), or the built-in scenario's; `who` needs it (named in the error of a missing
+    /// key).
+    pub fn rotor(&self, who: &str) -> Result<Rotor, ScenarioFileError> {
+        match &self.builtin {
+            Some(s) => Ok(s.rotor),
+            None => self.rotor_for(who),
+        }
+    }
+
     fn rotor_for_simulation(&self) -> Result<Rotor, ScenarioFileError> {
+        self.rotor_for("simulate")
+    }
+
+    fn rotor_for(&self, who: &str) -> Result<Rotor, ScenarioFileError> {
         let mut v = [0.0; 9];
         for (i, (k, _)) in ROTOR_KEYS.iter().enumerate() {
-            v[i] = self.require_rotor(k, "simulate")?;
+            v[i] = self.require_rotor(k, who)?;
         }
         // Values were range-checked when parsed; this cannot fail, but keep the mapping.
         Rotor::new(rotor_params(&v)).map_err(|e| self.rotor_error(e))

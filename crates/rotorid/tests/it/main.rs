@@ -4,6 +4,7 @@
 mod identify_common;
 
 mod acquisition;
+mod acquisition_iterated;
 mod adequacy;
 mod algebraic_windows;
 mod analysis;
@@ -17,6 +18,7 @@ mod identify_validation;
 mod modulating_clean;
 mod modulating_noise;
 mod pipeline;
+mod raw_reference;
 mod refine_clean;
 mod refine_crb;
 mod refine_identifiability;
