@@ -13,6 +13,10 @@ use rotorid_fleet::Channel;
 
 pub use rotorid_fleet::test_server::Server;
 
+/// Rotors eq. (1) does not describe, from the library's adequacy tests.
+#[path = "../../../rotorid/tests/it/defects.rs"]
+pub mod defects;
+
 /// Machine `i`'s rotor: table1 with kx, kz, cx, cz varied by a few per cent.
 pub fn rotor(i: usize) -> RotorParams {
     let p = Rotor::table1().params();
