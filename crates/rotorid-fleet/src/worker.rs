@@ -89,6 +89,11 @@ pub struct WorkerConfig {
     /// Print on stderr a line when a window is taken and one when it is done (just before
     /// its acknowledgement), and every dead letter and alert.
     pub verbose: bool,
+    /// A hook for tests that kill a worker: after taking this many windows, hold the last
+    /// one unacknowledged for ever (until the process is killed), having written
+    /// `holding window W of machine M (delivery D)` on stderr, so that a kill provably
+    /// lands on a window the server must redeliver. `None` (the default): never.
+    pub hold_after: Option<u64>,
 }
 
 impl WorkerConfig {
@@ -104,6 +109,7 @@ impl WorkerConfig {
             ack_wait: Duration::from_secs(30),
             max_deliveries: 5,
             verbose: false,
+            hold_after: None,
         }
     }
 }
@@ -182,6 +188,8 @@ struct Worker<'a> {
     drift: kv::Store,
     setups: HashMap<String, Arc<Setup>>,
     stats: WorkerStats,
+    /// Windows taken (for [`WorkerConfig::hold_after`]).
+    taken: u64,
 }
 
 /// Check the setup and create the streams, buckets and the consumer (all idempotent), so
@@ -231,6 +239,7 @@ pub async fn run(
         drift: fleet.drift().await?,
         setups: HashMap::new(),
         stats: WorkerStats::default(),
+        taken: 0,
     };
     tokio::pin!(shutdown);
     loop {
@@ -327,6 +336,15 @@ impl Worker<'_> {
                 "window {} of machine {} (stream seq {stream_seq}, delivery {delivered}) taken",
                 frame.window, frame.machine
             );
+        }
+        self.taken += 1;
+        if self.cfg.hold_after.is_some_and(|n| self.taken >= n) {
+            eprintln!(
+                "holding window {} of machine {} (delivery {delivered})",
+                frame.window, frame.machine
+            );
+            // unacknowledged until the process is killed (WorkerConfig::hold_after)
+            std::future::pending::<()>().await;
         }
         if delivered > self.cfg.max_deliveries {
             let r = dead(
