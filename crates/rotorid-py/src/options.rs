@@ -1,14 +1,17 @@
 //! The method and its settings from keyword arguments, with the rules of `rotorid identify`
 //! (crates/rotorid-cli/src/commands/identify.rs): each option belongs to some methods
 //! (`tol` to algebraic only, `window` to modulating and refine, `unknowns` to refine,
+//! `model = "auto"` to refine,
 //! `quadrature` to algebraic and refine's algebraic start; `rcond_min` to all) and is
 //! range-checked with the same words, so the same arguments give the same
 //! [`Method`] from Python as from the command line.
 
 use rotorid::identify::algebraic::Quadrature;
 use rotorid::identify::modulating::{ModulatingConfig, DEFAULT_WINDOW_S};
+use rotorid::parameter::Parameter;
 use rotorid::pipeline::{
-    AlgebraicSettings, Method, MethodName, ModulatingSettings, PipelineError, RefineSettings,
+    AlgebraicSettings, Method, MethodName, ModelChoice, ModulatingSettings, PipelineError,
+    RefineSettings,
 };
 use rotorid::refine::Unknowns;
 
@@ -17,15 +20,38 @@ use crate::error::Error;
 /// The method names, as Python passes them.
 pub const METHOD_NAMES: [&str; 3] = ["algebraic", "modulating", "refine"];
 
-/// The names `unknowns` takes: m, cx, kx, cz, kz, a, unbalance (m_u d and alpha).
-pub const UNKNOWN_NAMES: [&str; 7] = ["m", "cx", "kx", "cz", "kz", "a", "unbalance"];
+/// The names `unknowns` takes: the Jeffcott model's m, cx, kx, cz, kz, the cross-coupled
+/// model's cxx, cxz, czx, czz, kxx, kxz, kzx, kzz, a, and unbalance (m_u d and alpha).
+pub const UNKNOWN_NAMES: [&str; 15] = [
+    "m",
+    "cx",
+    "kx",
+    "cz",
+    "kz",
+    "a",
+    "unbalance",
+    "cxx",
+    "cxz",
+    "czx",
+    "czz",
+    "kxx",
+    "kxz",
+    "kzx",
+    "kzz",
+];
+
+/// The names `model` takes.
+pub const MODEL_NAMES: [&str; 3] = ["jeffcott", "cross_coupled", "auto"];
 
 /// The options of an identification besides the method's name; `None` is the method's
 /// default.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Options {
-    /// refine: the quantities to estimate, among [`UNKNOWN_NAMES`] (default m, cx, kx,
-    /// cz, kz; the initial state is always estimated).
+    /// The rotor model, among [`MODEL_NAMES`] (`auto`: refine only; default: the
+    /// scenario's).
+    pub model: Option<String>,
+    /// refine: the quantities to estimate, among [`UNKNOWN_NAMES`] (default m and the
+    /// model's bearing coefficients; the initial state is always estimated).
     pub unknowns: Option<Vec<String>>,
     /// Running quadrature of the algebraic identifier: trapezoid, am3, am4, am5.
     pub quadrature: Option<String>,
@@ -72,6 +98,23 @@ pub fn method(name: &str, o: &Options) -> Result<Method, Error> {
     only("quadrature", o.quadrature.is_some(), &[Algebraic, Refine])?;
     only("window", o.window.is_some(), &[Modulating, Refine])?;
     only("unknowns", o.unknowns.is_some(), &[Refine])?;
+    let model = match &o.model {
+        Some(name) => Some(name.parse::<ModelChoice>().map_err(|_| {
+            Error::invalid(format!(
+                "model = {name:?} is not a model: must be one of {}",
+                MODEL_NAMES.join(", ")
+            ))
+        })?),
+        None => None,
+    };
+    if model == Some(ModelChoice::Auto) && method != Refine {
+        return Err(Error::invalid(format!(
+            "model = \"auto\" applies to method refine only, not to method {}: choose \
+             \"jeffcott\" or \"cross_coupled\"",
+            method.as_str()
+        )));
+    }
+    let fixed = model.and_then(ModelChoice::fixed);
     let ok = |v: f64| v.is_finite() && v >= 0.0;
     let quadrature = match &o.quadrature {
         Some(q) => q
@@ -81,6 +124,7 @@ pub fn method(name: &str, o: &Options) -> Result<Method, Error> {
     };
     let mut algebraic = AlgebraicSettings {
         quadrature,
+        model: fixed,
         ..AlgebraicSettings::default()
     };
     if let Some(tol) = o.tol {
@@ -108,6 +152,7 @@ pub fn method(name: &str, o: &Options) -> Result<Method, Error> {
     }
     let mut modulating = ModulatingSettings {
         config: ModulatingConfig::with_window(window_s),
+        model: fixed,
     };
     if let Some(r) = o.rcond_min {
         if !(ok(r) && r <= 1.0) {
@@ -122,6 +167,7 @@ pub fn method(name: &str, o: &Options) -> Result<Method, Error> {
         Algebraic => Method::Algebraic(algebraic),
         Modulating => Method::Modulating(modulating),
         Refine => Method::Refine(RefineSettings {
+            model,
             unknowns: unknowns(o.unknowns.as_deref())?,
             algebraic,
             modulating,
@@ -141,11 +187,11 @@ pub fn time_tolerance(v: f64) -> Result<f64, Error> {
     }
 }
 
-/// The unknowns `names` select (default m, cx, kx, cz, kz); the initial state is always
-/// estimated.
-fn unknowns(names: Option<&[String]>) -> Result<Unknowns, Error> {
+/// The unknowns `names` select (`None`: the model's default); the initial state is
+/// always estimated.
+fn unknowns(names: Option<&[String]>) -> Result<Option<Unknowns>, Error> {
     let Some(names) = names else {
-        return Ok(Unknowns::default());
+        return Ok(None);
     };
     if names.is_empty() {
         return Err(Error::invalid(format!(
@@ -159,17 +205,14 @@ fn unknowns(names: Option<&[String]>) -> Result<Unknowns, Error> {
             UNKNOWN_NAMES.join(", ")
         )));
     }
-    let has = |n: &str| names.iter().any(|m| m == n);
-    Ok(Unknowns {
-        m: has("m"),
-        cx: has("cx"),
-        kx: has("kx"),
-        cz: has("cz"),
-        kz: has("kz"),
-        a: has("a"),
-        unbalance: has("unbalance"),
-        initial_state: true,
-    })
+    let ps: Vec<Parameter> = names
+        .iter()
+        .flat_map(|n| match n.as_str() {
+            "unbalance" => vec![Parameter::Mud, Parameter::Alpha],
+            other => other.parse().into_iter().collect(),
+        })
+        .collect();
+    Ok(Some(Unknowns::from_parameters(&ps, true)))
 }
 
 #[cfg(test)]
@@ -239,8 +282,30 @@ mod tests {
         let Method::Refine(s) = method("refine", &o).unwrap() else {
             panic!("refine expected")
         };
-        assert!(s.unknowns.m && s.unknowns.kx && s.unknowns.unbalance);
-        assert!(!s.unknowns.cx && !s.unknowns.a && s.unknowns.initial_state);
+        let u = s.unknowns.unwrap();
+        assert!(u.m && u.kx && u.unbalance);
+        assert!(!u.cx && !u.a && u.initial_state);
+        let cross = Options {
+            model: Some("cross_coupled".into()),
+            unknowns: Some(vec!["m".into(), "kxz".into(), "czx".into()]),
+            ..Options::default()
+        };
+        let Method::Refine(s) = method("refine", &cross).unwrap() else {
+            panic!("refine expected")
+        };
+        let u = s.unknowns.unwrap();
+        assert!(u.m && u.kxz && u.czx && !u.kzx && !u.kx);
+        assert_eq!(s.model, Some(ModelChoice::CrossCoupled));
+        let auto = Options {
+            model: Some("auto".into()),
+            ..Options::default()
+        };
+        assert!(err("modulating", auto).contains("refine only"));
+        let typo = Options {
+            model: Some("crosscoupled".into()),
+            ..Options::default()
+        };
+        assert!(err("refine", typo).starts_with("model = \"crosscoupled\" is not a model"));
         let bad = Options {
             unknowns: Some(vec!["mass".into()]),
             ..Options::default()

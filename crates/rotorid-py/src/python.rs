@@ -449,6 +449,7 @@ impl PyBlocks {
 
 /// The options of a call.
 fn options_of(
+    model: Option<String>,
     unknowns: Option<Vec<String>>,
     quadrature: Option<String>,
     rcond_min: Option<f64>,
@@ -457,6 +458,7 @@ fn options_of(
     restart: Option<f64>,
 ) -> Options {
     Options {
+        model,
         unknowns,
         quadrature,
         rcond_min,
@@ -469,7 +471,7 @@ fn options_of(
 /// Identify a record: (summary JSON, estimates dict, seconds spent in the library).
 #[pyfunction]
 #[pyo3(signature = (scenario, method, t, x, z, phi=None, phi_dot=None, phi_ddot=None, *,
-    unknowns=None, quadrature=None, rcond_min=None, tol=None, window=None,
+    model=None, unknowns=None, quadrature=None, rcond_min=None, tol=None, window=None,
     restart=None, time_tolerance=DEFAULT_TIME_TOLERANCE, input=None, scenario_name=None))]
 #[allow(clippy::too_many_arguments)]
 fn identify<'py>(
@@ -482,6 +484,7 @@ fn identify<'py>(
     phi: Option<&Bound<'py, PyAny>>,
     phi_dot: Option<&Bound<'py, PyAny>>,
     phi_ddot: Option<&Bound<'py, PyAny>>,
+    model: Option<String>,
     unknowns: Option<Vec<String>>,
     quadrature: Option<String>,
     rcond_min: Option<f64>,
@@ -492,7 +495,7 @@ fn identify<'py>(
     input: Option<String>,
     scenario_name: Option<String>,
 ) -> PyResult<(String, Bound<'py, PyDict>, f64)> {
-    let o = options_of(unknowns, quadrature, rcond_min, tol, window, restart);
+    let o = options_of(model, unknowns, quadrature, rcond_min, tol, window, restart);
     let method = options::method(method, &o).map_err(py_err)?;
     let held = Held::new(Some(t), x, z, [phi, phi_dot, phi_ddot])?;
     let columns = held.columns()?;
@@ -529,8 +532,8 @@ impl PySession {
 #[pymethods]
 impl PySession {
     #[new]
-    #[pyo3(signature = (scenario, method="algebraic", dt=None, t0=0.0, *, unknowns=None,
-        quadrature=None, rcond_min=None, tol=None, window=None, restart=None,
+    #[pyo3(signature = (scenario, method="algebraic", dt=None, t0=0.0, *, model=None,
+        unknowns=None, quadrature=None, rcond_min=None, tol=None, window=None, restart=None,
         time_tolerance=DEFAULT_TIME_TOLERANCE))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -538,6 +541,7 @@ impl PySession {
         method: &str,
         dt: Option<f64>,
         t0: f64,
+        model: Option<String>,
         unknowns: Option<Vec<String>>,
         quadrature: Option<String>,
         rcond_min: Option<f64>,
@@ -546,7 +550,7 @@ impl PySession {
         restart: Option<f64>,
         time_tolerance: f64,
     ) -> PyResult<Self> {
-        let o = options_of(unknowns, quadrature, rcond_min, tol, window, restart);
+        let o = options_of(model, unknowns, quadrature, rcond_min, tol, window, restart);
         let method = options::method(method, &o).map_err(py_err)?;
         let grid = dt.map(|dt| (t0, dt));
         let s = Stream::new(&scenario.inner, &method, grid, time_tolerance).map_err(py_err)?;

@@ -6,7 +6,7 @@
 //! SNR, together with what any identification of it must be judged against: the true
 //! rotor, the knowledge a caller has, and the Cramer-Rao bound of the experiment.
 
-use crate::model::{RotorParams, Scenario};
+use crate::model::{CrossCoupling, Rotor, RotorParams, Scenario};
 use crate::pipeline::{Knowledge, Record};
 use crate::refine::{crb_at_snr, Crb, Unknowns};
 use crate::simulate::{add_noise, simulate, Method, TimeResponse};
@@ -83,6 +83,45 @@ pub fn table1() -> TestModel {
 pub fn table1_ramp(rpm0: f64) -> TestModel {
     let s = Scenario::table1_ramp(rpm0).expect("a valid ramp");
     TestModel::clean(&format!("table1_ramp{rpm0}"), s)
+}
+
+/// A rotor on cross-coupled bearings (docs/method.md section 1.6): table1's m, a and
+/// unbalance on stiffer, anisotropic, well damped bearings (kxx = 1.195e6, kzz = 1.4e6 N/m,
+/// cxx = czz = 200 N s/m: damping ratio 2.4 %) with a destabilising cross-coupled
+/// stiffness kxz = -kzx = -3e4 N/m (2.5 % of kxx; it drives forward whirl and halves its
+/// damping, the threshold being about 5.8e4 N/m) and cross damping cxz = czx = 20 N s/m.
+pub fn cross_coupled_rotor() -> RotorParams {
+    RotorParams {
+        kz: 1.4e6,
+        cx: 200.0,
+        cz: 200.0,
+        coupling: Some(CrossCoupling {
+            cxz: 20.0,
+            czx: 20.0,
+            kxz: -3.0e4,
+            kzx: 3.0e4,
+        }),
+        ..Rotor::table1().params()
+    }
+}
+
+/// [`cross_coupled_rotor`] at 1200 rpm, 1 s at 10 kHz, from rest, noise-free.
+pub fn cross_coupled() -> TestModel {
+    let s = Scenario {
+        rotor: Rotor::new(cross_coupled_rotor()).expect("a valid rotor"),
+        ..Scenario::table1()
+    };
+    TestModel::clean("cross_coupled", s)
+}
+
+/// [`cross_coupled_rotor`] on the 10 rad/s^2 run-up from `rpm0`, 1 s at 10 kHz, from rest,
+/// noise-free.
+pub fn cross_coupled_ramp(rpm0: f64) -> TestModel {
+    let s = Scenario {
+        rotor: Rotor::new(cross_coupled_rotor()).expect("a valid rotor"),
+        ..Scenario::table1_ramp(rpm0).expect("a valid ramp")
+    };
+    TestModel::clean(&format!("cross_coupled_ramp{rpm0}"), s)
 }
 
 /// `p` with m, cz, kz 1 % high and cx, kx 1 % low: a start inside the refinement's basin,

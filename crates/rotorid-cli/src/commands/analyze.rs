@@ -231,6 +231,7 @@ pub fn load_rotor(
                 })
             };
             let params = RotorParams {
+                coupling: None,
                 m: need(t.m, "m", "kg")?,
                 cx: need(t.cx, "cx", "N s/m")?,
                 cz: need(t.cz, "cz", "N s/m")?,

@@ -82,6 +82,7 @@ impl IdentifiedRotor {
         }
         let [m, cx, kx, cz, kz, a, mud, alpha] = v;
         let params = RotorParams {
+            coupling: None,
             m,
             cx,
             cz,

@@ -77,6 +77,8 @@ fn pipeline_recovers_table1_and_writes_every_summary_field() {
         "input",
         "scenario",
         "method",
+        "model",
+        "model_selection",
         "record",
         "parameters",
         "rotor",
@@ -85,7 +87,9 @@ fn pipeline_recovers_table1_and_writes_every_summary_field() {
     ] {
         assert!(s.get(key).is_some(), "summary lacks {key}: {s}");
     }
-    assert_eq!(s["schema"], 2);
+    assert_eq!(s["schema"], 3);
+    assert_eq!(s["model"], "jeffcott");
+    assert!(s["model_selection"].is_null());
     assert_eq!(s["record"]["samples"], 3001);
     assert_eq!(s["record"]["dt_s"], 1e-4);
     assert_eq!(s["method"], "algebraic");

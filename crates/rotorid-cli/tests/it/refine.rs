@@ -222,7 +222,7 @@ fn unknown_names_are_refused_with_the_allowed_ones() {
     assert!(r.stderr.contains("'k'"), "{}", r.stderr);
     assert!(
         r.stderr
-            .contains("[possible values: m, cx, kx, cz, kz, a, unbalance]"),
+            .contains("[possible values: m, cx, kx, cz, kz, a, unbalance, cxx, cxz, czx, czz, kxx, kxz, kzx, kzz]"),
         "{}",
         r.stderr
     );

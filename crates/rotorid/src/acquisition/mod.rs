@@ -307,6 +307,7 @@ impl ModelGuess {
             }
         }
         let rotor = RotorParams {
+            coupling: None,
             m,
             cx: get(Parameter::Cx)?.max(0.0),
             kx: stiffness(Parameter::Kx)?,

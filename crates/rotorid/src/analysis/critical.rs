@@ -183,6 +183,7 @@ mod tests {
     /// Rotor parameters with the values `v` (m, cx, kx, cz, kz, a; unbalance unchanged).
     fn with_values(p: &RotorParams, v: &Gradient) -> RotorParams {
         RotorParams {
+            coupling: None,
             m: v[0],
             cx: v[1],
             kx: v[2],

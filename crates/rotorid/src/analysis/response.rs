@@ -251,6 +251,7 @@ mod tests {
     fn from_values(p: &RotorParams, v: &Gradient) -> RotorParams {
         let mud = v[6].hypot(v[7]);
         RotorParams {
+            coupling: None,
             m: v[0],
             cx: v[1],
             kx: v[2],

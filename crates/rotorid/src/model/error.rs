@@ -36,6 +36,23 @@ pub enum ModelError {
     /// Two fields that are each valid do not fit together.
     #[error("{0}")]
     Inconsistent(String),
+    /// The damping matrix's symmetric part is not positive semi-definite: the bearings
+    /// would feed energy into every motion in some direction.
+    #[error(
+        "the damping matrix [[cxx, cxz], [czx, czz]] = [[{cxx}, {cxz}], [{czx}, {czz}]] N s/m \
+         is not dissipative: its symmetric part must be positive semi-definite, \
+         cxx >= 0, czz >= 0 and cxx czz >= ((cxz + czx) / 2)^2"
+    )]
+    DampingNotDissipative {
+        /// cxx \[N s/m\].
+        cxx: f64,
+        /// cxz \[N s/m\].
+        cxz: f64,
+        /// czx \[N s/m\].
+        czx: f64,
+        /// czz \[N s/m\].
+        czz: f64,
+    },
 }
 
 impl From<OutOfRange> for ModelError {

@@ -25,7 +25,7 @@ mod speed;
 
 pub(crate) use error::check;
 pub use error::{ModelError, OutOfRange};
-pub use rotor::{unbalance_force_from, Rotor, RotorParams, Unbalance};
+pub use rotor::{unbalance_force_from, CrossCoupling, Rotor, RotorParams, Unbalance};
 pub use scenario::{InitialState, Sampling, Scenario};
 pub use speed::{SpeedProfile, SpeedState};
 

@@ -1,10 +1,24 @@
-//! Rotor parameters and the M, C(w), K(w') matrices and unbalance force of eq. (1).
+//! Rotor parameters and the M, C(w), K(w') matrices and unbalance force of eq. (1), for
+//! the paper's Jeffcott rotor and for the same rotor on cross-coupled bearings
+//! (docs/method.md section 1.6):
+//!
+//! ```text
+//! C(w)  = [[cx, cxz], [czx, cz]] + w  [[0, -a], [a, 0]]
+//! K(w') = [[kx, kxz], [kzx, kz]] + w' [[0, -a], [0, 0]]
+//! ```
+//!
+//! kxz is the bearing's restoring force in x per unit displacement in z \[N/m\] (it stands on
+//! the left of the x equation, as kx does); likewise cxz \[N s/m\], and czx, kzx in z. The
+//! Jeffcott rotor is the model without them ([`RotorParams::coupling`] `None`); the
+//! cross-coupled model names its direct coefficients cxx, czz, kxx, kzz (the fields cx, cz,
+//! kx, kz).
 
 use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 
 use super::error::{check, ModelError};
 use super::speed::SpeedState;
+use crate::parameter::{ModelKind, Parameter};
 
 /// Unbalance: a mass `m_u` at radius `d` and angular position `alpha` on the disk.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -22,6 +36,21 @@ impl Unbalance {
     pub fn mud(&self) -> f64 {
         self.m_u * self.d
     }
+}
+
+/// The cross-coupled coefficients of the bearings (module doc): the off-diagonal terms of
+/// the damping and stiffness matrices. Any sign; all zero is a Jeffcott rotor written in
+/// the cross-coupled model.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct CrossCoupling {
+    /// Damping force in x per unit velocity in z, cxz \[N s/m\].
+    pub cxz: f64,
+    /// Damping force in z per unit velocity in x, czx \[N s/m\].
+    pub czx: f64,
+    /// Restoring force in x per unit displacement in z, kxz \[N/m\].
+    pub kxz: f64,
+    /// Restoring force in z per unit displacement in x, kzx \[N/m\].
+    pub kzx: f64,
 }
 
 /// Unvalidated rotor parameters, as a user writes them (SI units). Turn into a [`Rotor`]
@@ -42,6 +71,72 @@ pub struct RotorParams {
     pub a: f64,
     /// The unbalance that drives the rotor.
     pub unbalance: Unbalance,
+    /// The bearings' cross-coupled coefficients: `None` is the paper's Jeffcott rotor (the
+    /// Jeffcott model), `Some` the cross-coupled model (module doc).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coupling: Option<CrossCoupling>,
+}
+
+impl RotorParams {
+    /// The model these parameters describe: Jeffcott without coupling, else cross-coupled.
+    pub fn model(&self) -> ModelKind {
+        match self.coupling {
+            None => ModelKind::Jeffcott,
+            Some(_) => ModelKind::CrossCoupled,
+        }
+    }
+
+    /// The cross-coupled coefficients (all zero for a Jeffcott rotor).
+    pub fn cross(&self) -> CrossCoupling {
+        self.coupling.unwrap_or_default()
+    }
+
+    /// The value of `p` \[its unit\], when `p` is a parameter of these values' model (m_x
+    /// and m_z are m; mud and alpha the unbalance's).
+    pub fn get(&self, p: Parameter) -> Option<f64> {
+        let c = self.coupling;
+        Some(match p {
+            Parameter::M | Parameter::MX | Parameter::MZ => self.m,
+            Parameter::Cx | Parameter::Cxx => self.cx,
+            Parameter::Kx | Parameter::Kxx => self.kx,
+            Parameter::Cz | Parameter::Czz => self.cz,
+            Parameter::Kz | Parameter::Kzz => self.kz,
+            Parameter::A => self.a,
+            Parameter::Mud => self.unbalance.mud(),
+            Parameter::Alpha => self.unbalance.alpha,
+            Parameter::Cxz => c?.cxz,
+            Parameter::Czx => c?.czx,
+            Parameter::Kxz => c?.kxz,
+            Parameter::Kzx => c?.kzx,
+        })
+    }
+
+    /// Set `p` to `v` \[its unit\]; a cross-coupled coefficient makes the model cross-coupled
+    /// (the other cross terms 0 unless set), mud keeps the radius d (d = 1 m when d is 0).
+    pub fn set(&mut self, p: Parameter, v: f64) {
+        fn cross(c: &mut Option<CrossCoupling>) -> &mut CrossCoupling {
+            c.get_or_insert_with(CrossCoupling::default)
+        }
+        match p {
+            Parameter::M | Parameter::MX | Parameter::MZ => self.m = v,
+            Parameter::Cx | Parameter::Cxx => self.cx = v,
+            Parameter::Kx | Parameter::Kxx => self.kx = v,
+            Parameter::Cz | Parameter::Czz => self.cz = v,
+            Parameter::Kz | Parameter::Kzz => self.kz = v,
+            Parameter::A => self.a = v,
+            Parameter::Mud => {
+                if self.unbalance.d == 0.0 {
+                    self.unbalance.d = 1.0;
+                }
+                self.unbalance.m_u = v / self.unbalance.d;
+            }
+            Parameter::Alpha => self.unbalance.alpha = v,
+            Parameter::Cxz => cross(&mut self.coupling).cxz = v,
+            Parameter::Czx => cross(&mut self.coupling).czx = v,
+            Parameter::Kxz => cross(&mut self.coupling).kxz = v,
+            Parameter::Kzx => cross(&mut self.coupling).kzx = v,
+        }
+    }
 }
 
 /// A validated 2-DOF rotor (paper eq. 1). Fields are read through accessors so a `Rotor`
@@ -52,19 +147,59 @@ pub struct Rotor {
 }
 
 impl Rotor {
-    /// Validate `p`: all finite; m > 0; kx, kz > 0; cx, cz >= 0; m_u, d >= 0.
+    /// Validate `p`: all finite; m > 0; kx, kz > 0; cx, cz >= 0; m_u, d >= 0; with
+    /// cross-coupling (names of the cross-coupled model: kxx, kzz, cxx, czz) the cross terms
+    /// any finite value and the damping matrix's symmetric part positive semi-definite
+    /// (cxx czz >= ((cxz + czx) / 2)^2: the bearings dissipate energy, they cannot feed it).
     pub fn new(p: RotorParams) -> Result<Self, ModelError> {
         check("m", p.m, "finite and > 0 (kg)", |v| v > 0.0)?;
-        check("cx", p.cx, "finite and >= 0 (N s/m)", |v| v >= 0.0)?;
-        check("cz", p.cz, "finite and >= 0 (N s/m)", |v| v >= 0.0)?;
-        check("kx", p.kx, "finite and > 0 (N/m)", |v| v > 0.0)?;
-        check("kz", p.kz, "finite and > 0 (N/m)", |v| v > 0.0)?;
+        let cross = p.coupling.is_some();
+        let name = |jeffcott: &'static str, coupled: &'static str| {
+            if cross {
+                coupled
+            } else {
+                jeffcott
+            }
+        };
+        check(name("cx", "cxx"), p.cx, "finite and >= 0 (N s/m)", |v| {
+            v >= 0.0
+        })?;
+        check(name("cz", "czz"), p.cz, "finite and >= 0 (N s/m)", |v| {
+            v >= 0.0
+        })?;
+        check(name("kx", "kxx"), p.kx, "finite and > 0 (N/m)", |v| v > 0.0)?;
+        check(name("kz", "kzz"), p.kz, "finite and > 0 (N/m)", |v| v > 0.0)?;
         check("a", p.a, "finite (N s^2/m)", |_| true)?;
         let u = p.unbalance;
         check("m_u", u.m_u, "finite and >= 0 (kg)", |v| v >= 0.0)?;
         check("d", u.d, "finite and >= 0 (m)", |v| v >= 0.0)?;
         check("alpha", u.alpha, "finite (rad)", |_| true)?;
+        if let Some(c) = p.coupling {
+            check("cxz", c.cxz, "finite (N s/m)", |_| true)?;
+            check("czx", c.czx, "finite (N s/m)", |_| true)?;
+            check("kxz", c.kxz, "finite (N/m)", |_| true)?;
+            check("kzx", c.kzx, "finite (N/m)", |_| true)?;
+            let s = 0.5 * (c.cxz + c.czx);
+            if p.cx * p.cz < s * s {
+                return Err(ModelError::DampingNotDissipative {
+                    cxx: p.cx,
+                    cxz: c.cxz,
+                    czx: c.czx,
+                    czz: p.cz,
+                });
+            }
+        }
         Ok(Self { p })
+    }
+
+    /// The model of this rotor (Jeffcott without cross-coupling, else cross-coupled).
+    pub fn model(&self) -> ModelKind {
+        self.p.model()
+    }
+
+    /// The cross-coupled coefficients (zero for a Jeffcott rotor).
+    pub fn cross(&self) -> CrossCoupling {
+        self.p.cross()
     }
 
     /// The paper's Table 1: m = 14.29 kg, cx = cz = 10 N s/m, kx = kz = 1.195e6 N/m,
@@ -82,6 +217,7 @@ impl Rotor {
                 d: 0.15,
                 alpha: 45f64.to_radians(),
             },
+            coupling: None,
         })
         .expect("Table 1 is a valid rotor")
     }
@@ -124,15 +260,19 @@ impl Rotor {
         Matrix2::identity() * self.p.m
     }
 
-    /// C(w) = diag(cx, cz) + w [[0, -a], [a, 0]] \[N s/m\], w in rad/s.
+    /// C(w) = [[cx, cxz], [czx, cz]] + w [[0, -a], [a, 0]] \[N s/m\], w in rad/s (cxz = czx
+    /// = 0 for a Jeffcott rotor).
     pub fn damping_matrix(&self, w: f64) -> Matrix2<f64> {
         let aw = self.p.a * w;
-        Matrix2::new(self.p.cx, -aw, aw, self.p.cz)
+        let c = self.cross();
+        Matrix2::new(self.p.cx, c.cxz - aw, c.czx + aw, self.p.cz)
     }
 
-    /// K(w') = diag(kx, kz) + w' [[0, -a], [0, 0]] \[N/m\], w' in rad/s^2.
+    /// K(w') = [[kx, kxz], [kzx, kz]] + w' [[0, -a], [0, 0]] \[N/m\], w' in rad/s^2 (kxz =
+    /// kzx = 0 for a Jeffcott rotor).
     pub fn stiffness_matrix(&self, w_dot: f64) -> Matrix2<f64> {
-        Matrix2::new(self.p.kx, -self.p.a * w_dot, 0.0, self.p.kz)
+        let c = self.cross();
+        Matrix2::new(self.p.kx, c.kxz - self.p.a * w_dot, c.kzx, self.p.kz)
     }
 
     /// Unbalance force F \[N\] at the rotor state `s`:

@@ -202,6 +202,21 @@ pub enum Finding {
         /// The fitted sampling period \[s\].
         dt_s: f64,
     },
+    /// `--model auto` chose this model (the summary's `model_selection` has the figures).
+    ModelSelected {
+        /// The model taken.
+        model: crate::parameter::ModelKind,
+        /// Why, in words.
+        reason: String,
+    },
+    /// The model fitted leaves structure in its residuals that another model explains.
+    OtherModelExplains {
+        /// The model whose residuals pass the adequacy test.
+        model: crate::parameter::ModelKind,
+        /// BIC of the fitted model minus that of the other (positive: the other is
+        /// better).
+        bic_difference: f64,
+    },
 }
 
 /// A finding with its severity and message (module doc).
@@ -227,7 +242,7 @@ impl Diagnostic {
         }
     }
 
-    /// The note (worth knowing, the numbers stand) of one of the pipeline's findings.
+    /// A finding worth knowing that leaves the numbers standing ([`Severity::Note`]).
     pub(crate) fn note(finding: Finding) -> Self {
         Self {
             severity: Severity::Note,
@@ -258,7 +273,7 @@ impl std::fmt::Display for Diagnostic {
 impl From<&Warning> for Diagnostic {
     fn from(w: &Warning) -> Self {
         let finding = match w {
-            Warning::NotIdentifiable { parameters } => Finding::NotIdentifiable {
+            Warning::NotIdentifiable { parameters, .. } => Finding::NotIdentifiable {
                 quantities: parameters.iter().map(|s| (*s).to_owned()).collect(),
             },
             Warning::IllConditioned {
@@ -435,6 +450,20 @@ fn message(f: &Finding) -> String {
              (dt = {dt_s:e} s), which that rounding explains; the identification uses the \
              grid",
             max_deviation_s / dt_s
+        ),
+        Finding::ModelSelected { model, reason } => {
+            format!("model {model} (chosen by --model auto): {reason}")
+        }
+        Finding::OtherModelExplains {
+            model,
+            bic_difference,
+        } => format!(
+            "{} explain these data: the {model} model's residuals pass the adequacy test (BIC \
+             lower by {bic_difference:.1}); identify with --model {model} or --model auto",
+            match model {
+                crate::parameter::ModelKind::CrossCoupled => "cross-coupled bearings",
+                crate::parameter::ModelKind::Jeffcott => "a Jeffcott rotor",
+            }
         ),
         // The refinement's findings are made from its warnings (`From<&Warning>`), which
         // carry their own sentences; this is only their fallback.

@@ -10,14 +10,16 @@ use serde::{Deserialize, Serialize};
 
 use crate::identify::algebraic::{AlgebraicEstimate, Quadrature};
 use crate::model::RotorParams;
-use crate::parameter::Parameter;
+use crate::parameter::{ModelKind, Parameter};
 
 use super::diagnostic::{Diagnostic, Directions};
 use super::method::MethodName;
 use super::record::SpeedSource;
 
-/// Version of the serialised form; incremented on incompatible changes.
-pub const IDENTIFICATION_SCHEMA: u32 = 2;
+/// Version of the serialised form; incremented on incompatible changes (3: `model`, the
+/// cross-coupled model's parameter names, `rotor` keyed by the model's parameters,
+/// `model_selection`).
+pub const IDENTIFICATION_SCHEMA: u32 = 3;
 
 /// The record as the pipeline saw it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -98,48 +100,167 @@ impl ParameterResult {
     }
 }
 
-/// Every rotor parameter of eq. (1), SI units (kg, N s/m, N/m, N s^2/m, kg m, rad).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// Every parameter of the model used (estimated, else known), by name, in the model's
+/// order, SI units (kg, N s/m, N/m, N s^2/m, kg m, rad): for the Jeffcott model m, cx, kx,
+/// cz, kz, a, mud, alpha; for the cross-coupled model m, cxx, cxz, czx, czz, kxx, kxz, kzx,
+/// kzz, a, mud, alpha. Serialised as a JSON object of those names.
+#[derive(Debug, Clone, PartialEq)]
 pub struct RotorSummary {
-    /// m \[kg\].
-    pub m: f64,
-    /// cx \[N s/m\].
-    pub cx: f64,
-    /// kx \[N/m\].
-    pub kx: f64,
-    /// cz \[N s/m\].
-    pub cz: f64,
-    /// kz \[N/m\].
-    pub kz: f64,
-    /// a \[N s^2/m\].
-    pub a: f64,
-    /// m_u d \[kg m\].
-    pub mud: f64,
-    /// alpha \[rad\].
-    pub alpha: f64,
+    model: ModelKind,
+    values: Vec<(Parameter, f64)>,
 }
 
 impl RotorSummary {
-    /// The values of `p`.
+    /// The values of `p`, in its model.
     pub fn of(p: &RotorParams) -> Self {
+        let model = p.model();
         Self {
-            m: p.m,
-            cx: p.cx,
-            kx: p.kx,
-            cz: p.cz,
-            kz: p.kz,
-            a: p.a,
-            mud: p.unbalance.mud(),
-            alpha: p.unbalance.alpha,
+            model,
+            values: model
+                .parameters()
+                .iter()
+                .map(|&q| (q, p.get(q).unwrap_or(f64::NAN)))
+                .collect(),
         }
     }
+
+    /// The model whose parameters these are.
+    pub fn model(&self) -> ModelKind {
+        self.model
+    }
+
+    /// The value of `p` (either model's name of a direct coefficient), if the model has it.
+    pub fn get(&self, p: Parameter) -> Option<f64> {
+        let q = self.model.own(p.physical())?;
+        self.values.iter().find(|(r, _)| *r == q).map(|(_, v)| *v)
+    }
+
+    /// Every (parameter, value), in the model's order.
+    pub fn values(&self) -> &[(Parameter, f64)] {
+        &self.values
+    }
+
+    /// The rotor parameters (the unbalance as m_u = mud, d = 1 m).
+    pub fn params(&self) -> RotorParams {
+        let mut p = RotorParams {
+            m: f64::NAN,
+            cx: f64::NAN,
+            cz: f64::NAN,
+            kx: f64::NAN,
+            kz: f64::NAN,
+            a: f64::NAN,
+            unbalance: crate::model::Unbalance {
+                m_u: 0.0,
+                d: 1.0,
+                alpha: 0.0,
+            },
+            coupling: (self.model == ModelKind::CrossCoupled).then(Default::default),
+        };
+        for &(q, v) in &self.values {
+            p.set(q, v);
+        }
+        p
+    }
+}
+
+impl Serialize for RotorSummary {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = s.serialize_map(Some(self.values.len()))?;
+        for (p, v) in &self.values {
+            map.serialize_entry(p.name(), v)?;
+        }
+        map.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for RotorSummary {
+    /// An object of one model's parameter names (the model is the one whose names appear:
+    /// cross-coupled when any of cxx .. kzz is there).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let map = std::collections::BTreeMap::<String, f64>::deserialize(d)?;
+        let mut values = Vec::new();
+        for (name, v) in &map {
+            let p: Parameter = name.parse().map_err(D::Error::custom)?;
+            values.push((p, *v));
+        }
+        let model = if values
+            .iter()
+            .any(|(p, _)| ModelKind::Jeffcott.own(*p) != Some(*p))
+        {
+            ModelKind::CrossCoupled
+        } else {
+            ModelKind::Jeffcott
+        };
+        let mut ordered = Vec::new();
+        for &q in model.parameters() {
+            match values.iter().find(|(p, _)| *p == q) {
+                Some(&pv) => ordered.push(pv),
+                None => {
+                    return Err(D::Error::custom(format!(
+                        "rotor: the {} model's parameter {q} is missing",
+                        model.name()
+                    )))
+                }
+            }
+        }
+        if ordered.len() != values.len() {
+            return Err(D::Error::custom(format!(
+                "rotor: parameters of another model than {}",
+                model.name()
+            )));
+        }
+        Ok(Self {
+            model,
+            values: ordered,
+        })
+    }
+}
+
+/// How the pipeline chose the model (`--model auto`, docs/method.md section 6.6).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelSelection {
+    /// The rule: among the candidates whose residuals pass the adequacy test, the lowest
+    /// Bayesian information criterion; when none passes, the lowest criterion (its values
+    /// withheld as inadequate).
+    pub criterion: String,
+    /// Every model fitted, simplest first.
+    pub candidates: Vec<ModelCandidate>,
+    /// The model taken.
+    pub chosen: ModelKind,
+    /// Why, in words.
+    pub reason: String,
+}
+
+/// One model fitted during the selection.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelCandidate {
+    /// The model.
+    pub model: ModelKind,
+    /// Quantities estimated: parameters, initial state and the two noise levels.
+    pub estimated: u64,
+    /// The maximised Gaussian log-likelihood of x and z (dimensionless).
+    pub log_likelihood: f64,
+    /// BIC = -2 ln L + (estimated) ln(2 N), N samples per channel (dimensionless; lower
+    /// is better).
+    pub bic: f64,
+    /// Whether the residuals pass the adequacy test (`None`: not computed).
+    pub adequate: Option<bool>,
+    /// Residual level over the data's noise level, x and z (about 1 for a correct model).
+    pub noise_ratio: Directions<f64>,
+    /// The fit converged.
+    pub converged: bool,
+    /// The unknowns are identifiable from the record.
+    pub identifiable: bool,
 }
 
 /// A covariance matrix over named quantities (`None` = not finite).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Covariance {
-    /// Row and column names: m, cx, kx, cz, kz, a, mud_cos_alpha, mud_sin_alpha, x0, z0,
-    /// vx0, vz0 (those estimated).
+    /// Row and column names: the model's parameters estimated (m, cx, kx, cz, kz, a or
+    /// m, cxx, kxx, czz, kzz, a, then cxz, czx, kxz, kzx), mud_cos_alpha, mud_sin_alpha,
+    /// x0, z0, vx0, vz0 (those estimated).
     pub names: Vec<String>,
     /// Row-major entries in the product of the two names' units.
     pub matrix: Vec<Vec<Option<f64>>>,
@@ -228,6 +349,9 @@ pub enum StartSource {
     Nominal,
     /// Values the caller gave.
     Given,
+    /// The estimate of a smaller model nested in this one (`--model auto`: the Jeffcott
+    /// fit, with the cross-coupled coefficients at 0 or their nominal values).
+    NestedModel,
 }
 
 /// The refinement's start.
@@ -309,17 +433,25 @@ pub struct Identification {
     pub schema: u32,
     /// The method.
     pub method: MethodName,
+    /// The rotor model the values belong to (schema 2 files: jeffcott).
+    #[serde(default)]
+    pub model: ModelKind,
+    /// How the model was chosen, when the pipeline chose it (`--model auto`).
+    #[serde(default)]
+    pub model_selection: Option<ModelSelection>,
     /// The input's name, when the caller gives one.
     pub input: Option<String>,
     /// The scenario's name, when the caller gives one.
     pub scenario: Option<String>,
     /// The record.
     pub record: RecordInfo,
-    /// The identified parameters: algebraic and modulating: m_x, cx, kx, m_z, cz, kz;
-    /// refine: its unknowns among m, cx, kx, cz, kz, a, mud, alpha.
+    /// The identified parameters: algebraic and modulating: m_x, cx, kx, m_z, cz, kz
+    /// (cross-coupled model: m_x, cxx, cxz, kxx, kxz, m_z, czx, czz, kzx, kzz); refine:
+    /// its unknowns among the model's parameters, in the model's order.
     pub parameters: Vec<ParameterResult>,
-    /// Every parameter of eq. (1) (estimated, else known), when all of m, c, k are
-    /// determined (algebraic and modulating: m is the mean of m_x and m_z).
+    /// Every parameter of the model (estimated, else known), when all its mass, damping
+    /// and stiffness values are determined (algebraic and modulating: m is the mean of
+    /// m_x and m_z).
     pub rotor: Option<RotorSummary>,
     /// refine: covariance of its internal unknowns (`mud_cos_alpha`, `mud_sin_alpha` for
     /// the unbalance).

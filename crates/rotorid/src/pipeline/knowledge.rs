@@ -7,52 +7,79 @@ use serde::{Deserialize, Serialize};
 
 use crate::identify::Known;
 use crate::model::{InitialState, RotorParams, Scenario, Unbalance};
-use crate::parameter::Parameter;
+use crate::parameter::{ModelKind, Parameter};
 
-/// Values of m \[kg\], cx, cz \[N s/m\], kx, kz \[N/m\], each possibly unknown.
+/// Values of m \[kg\], the damping \[N s/m\] and stiffness \[N/m\] coefficients, each
+/// possibly unknown. The direct coefficients cx, kx, cz, kz are the cross-coupled model's
+/// cxx, kxx, czz, kzz; the cross terms are `None` where not stated (a Jeffcott rotor's are
+/// 0: [`RotorValues::of`] states them as such only for a cross-coupled rotor).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct RotorValues {
     /// Mass m \[kg\].
     pub m: Option<f64>,
-    /// Damping cx \[N s/m\].
+    /// Damping cx (cxx) \[N s/m\].
     pub cx: Option<f64>,
-    /// Stiffness kx \[N/m\].
+    /// Stiffness kx (kxx) \[N/m\].
     pub kx: Option<f64>,
-    /// Damping cz \[N s/m\].
+    /// Damping cz (czz) \[N s/m\].
     pub cz: Option<f64>,
-    /// Stiffness kz \[N/m\].
+    /// Stiffness kz (kzz) \[N/m\].
     pub kz: Option<f64>,
+    /// Cross-coupled damping cxz \[N s/m\].
+    #[serde(default)]
+    pub cxz: Option<f64>,
+    /// Cross-coupled damping czx \[N s/m\].
+    #[serde(default)]
+    pub czx: Option<f64>,
+    /// Cross-coupled stiffness kxz \[N/m\].
+    #[serde(default)]
+    pub kxz: Option<f64>,
+    /// Cross-coupled stiffness kzx \[N/m\].
+    #[serde(default)]
+    pub kzx: Option<f64>,
 }
 
 impl RotorValues {
-    /// The values of `p` (m_x and m_z are m); `None` for a, mud, alpha.
+    /// The value of `p` (m_x and m_z are m; cxx is cx, ...); `None` for a, mud, alpha.
     pub fn get(&self, p: Parameter) -> Option<f64> {
-        match p.physical() {
-            Parameter::M => self.m,
-            Parameter::Cx => self.cx,
-            Parameter::Kx => self.kx,
-            Parameter::Cz => self.cz,
-            Parameter::Kz => self.kz,
-            _ => None,
+        use Parameter::*;
+        match p {
+            M | MX | MZ => self.m,
+            Cx | Cxx => self.cx,
+            Kx | Kxx => self.kx,
+            Cz | Czz => self.cz,
+            Kz | Kzz => self.kz,
+            Cxz => self.cxz,
+            Czx => self.czx,
+            Kxz => self.kxz,
+            Kzx => self.kzx,
+            A | Mud | Alpha => None,
         }
     }
 
-    /// All five of a rotor.
+    /// The values of a rotor: all five of a Jeffcott rotor, all nine of a cross-coupled one.
     pub fn of(p: &RotorParams) -> Self {
+        let c = p.coupling;
         Self {
             m: Some(p.m),
             cx: Some(p.cx),
             kx: Some(p.kx),
             cz: Some(p.cz),
             kz: Some(p.kz),
+            cxz: c.map(|c| c.cxz),
+            czx: c.map(|c| c.czx),
+            kxz: c.map(|c| c.kxz),
+            kzx: c.map(|c| c.kzx),
         }
     }
 
     /// True when no value is known.
     pub fn is_empty(&self) -> bool {
-        [self.m, self.cx, self.kx, self.cz, self.kz]
-            .iter()
-            .all(Option::is_none)
+        [
+            self.m, self.cx, self.kx, self.cz, self.kz, self.cxz, self.czx, self.kxz, self.kzx,
+        ]
+        .iter()
+        .all(Option::is_none)
     }
 }
 
@@ -68,6 +95,10 @@ pub struct Truth {
 /// What is known besides the record (module doc).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Knowledge {
+    /// The rotor model the caller describes (the scenario's `rotor.model`): the model of
+    /// an identification whose method names none.
+    #[serde(default)]
+    pub model: ModelKind,
     /// Gyroscopic coefficient a \[N s^2/m\].
     pub a: f64,
     /// The unbalance m_u \[kg\], d \[m\], alpha \[rad\] (only m_u d and alpha matter).
@@ -83,6 +114,7 @@ impl Knowledge {
     /// Only what eq. (1) needs as known: a, the unbalance; no nominal values, no truth.
     pub fn known(a: f64, unbalance: Unbalance) -> Self {
         Self {
+            model: ModelKind::Jeffcott,
             a,
             unbalance,
             nominal: RotorValues::default(),
@@ -95,6 +127,7 @@ impl Knowledge {
     pub fn from_scenario(s: &Scenario) -> Self {
         let p = s.rotor.params();
         Self {
+            model: p.model(),
             a: p.a,
             unbalance: p.unbalance,
             nominal: RotorValues::of(&p),

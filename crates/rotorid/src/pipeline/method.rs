@@ -7,6 +7,7 @@ use crate::identify::algebraic::{
 };
 use crate::identify::modulating::ModulatingConfig;
 use crate::model::{check, RotorParams};
+use crate::parameter::ModelKind;
 use crate::refine::{RefineOptions, Unknowns};
 
 use super::error::PipelineError;
@@ -34,6 +35,62 @@ impl MethodName {
     }
 }
 
+/// The rotor model an identification uses (docs/method.md sections 1.6 and 6.6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelChoice {
+    /// The paper's Jeffcott rotor.
+    Jeffcott,
+    /// The rotor on cross-coupled bearings.
+    CrossCoupled,
+    /// Refine: fit every candidate model, keep those whose residuals pass the adequacy
+    /// test and take the simplest by the Bayesian information criterion (the summary's
+    /// `model_selection` says what was compared and why).
+    Auto,
+}
+
+impl ModelChoice {
+    /// `jeffcott`, `cross_coupled` or `auto`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelChoice::Jeffcott => "jeffcott",
+            ModelChoice::CrossCoupled => "cross_coupled",
+            ModelChoice::Auto => "auto",
+        }
+    }
+
+    /// The one model, when not `Auto`.
+    pub fn fixed(self) -> Option<ModelKind> {
+        match self {
+            ModelChoice::Jeffcott => Some(ModelKind::Jeffcott),
+            ModelChoice::CrossCoupled => Some(ModelKind::CrossCoupled),
+            ModelChoice::Auto => None,
+        }
+    }
+}
+
+impl From<ModelKind> for ModelChoice {
+    fn from(m: ModelKind) -> Self {
+        match m {
+            ModelKind::Jeffcott => ModelChoice::Jeffcott,
+            ModelKind::CrossCoupled => ModelChoice::CrossCoupled,
+        }
+    }
+}
+
+impl std::str::FromStr for ModelChoice {
+    type Err = crate::parameter::UnknownModel;
+    /// `jeffcott`, `cross_coupled` or `auto`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s == "auto" {
+            return Ok(ModelChoice::Auto);
+        }
+        s.parse::<ModelKind>()
+            .map(ModelChoice::from)
+            .map_err(|_| crate::parameter::UnknownModel { name: s.to_owned() })
+    }
+}
+
 /// Settings of the algebraic identifier as the pipeline runs it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct AlgebraicSettings {
@@ -51,6 +108,10 @@ pub struct AlgebraicSettings {
     /// number of samples.
     #[serde(default)]
     pub restart_s: Option<f64>,
+    /// The rotor model: per direction m and that row's coefficients; `None` (default):
+    /// the knowledge's ([`super::Knowledge::model`], the scenario's).
+    #[serde(default)]
+    pub model: Option<ModelKind>,
 }
 
 impl Default for AlgebraicSettings {
@@ -60,6 +121,7 @@ impl Default for AlgebraicSettings {
             rcond_min: DEFAULT_ALGEBRAIC_RCOND_MIN,
             tol: DEFAULT_TOLERANCE,
             restart_s: None,
+            model: None,
         }
     }
 }
@@ -98,6 +160,10 @@ impl AlgebraicSettings {
 pub struct ModulatingSettings {
     /// Window, test functions, hop, noise compensation, rcond_min.
     pub config: ModulatingConfig,
+    /// The rotor model: per direction m and that row's coefficients; `None` (default):
+    /// the knowledge's ([`super::Knowledge::model`], the scenario's).
+    #[serde(default)]
+    pub model: Option<ModelKind>,
 }
 
 /// Where the refinement starts.
@@ -114,8 +180,16 @@ pub enum StartPolicy {
 /// Settings of the refinement.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub struct RefineSettings {
-    /// The unknowns (default m, cx, kx, cz, kz and the initial state).
-    pub unknowns: Unknowns,
+    /// The model: one, or `Auto` (chosen by the pipeline); `None` (default): the
+    /// knowledge's ([`super::Knowledge::model`], the scenario's). A given start
+    /// ([`StartPolicy::Given`]) needs a fixed model.
+    #[serde(default)]
+    pub model: Option<ModelChoice>,
+    /// The unknowns; `None` (default): the model's default, m and its bearing
+    /// coefficients ([`ModelKind::default_unknowns`]) and the initial state. With `Auto`,
+    /// given unknowns are the cross-coupled candidate's (the four cross terms added when
+    /// none is among them) and, without their cross terms, the Jeffcott candidate's.
+    pub unknowns: Option<Unknowns>,
     /// The start.
     pub start: StartPolicy,
     /// The fit's own options (iterations, tolerance, discretisation); its `unknowns`

@@ -45,13 +45,14 @@ pub use grid::{
     MAX_ROUNDING_ALLOWANCE, MAX_STAMP_DECIMALS, SNAP_DT, SNAP_T0,
 };
 pub use identification::{
-    AlgebraicDetail, Covariance, CrbAt, FinalEstimate, Identification, ModulatingDetail, Noise,
-    NoiseSource, ParameterResult, RecordInfo, RefineDetail, RotorSummary, Start, StartSource,
-    StateResult, IDENTIFICATION_SCHEMA,
+    AlgebraicDetail, Covariance, CrbAt, FinalEstimate, Identification, ModelCandidate,
+    ModelSelection, ModulatingDetail, Noise, NoiseSource, ParameterResult, RecordInfo,
+    RefineDetail, RotorSummary, Start, StartSource, StateResult, IDENTIFICATION_SCHEMA,
 };
 pub use knowledge::{Knowledge, RotorValues, Truth};
 pub use method::{
-    AlgebraicSettings, Method, MethodName, ModulatingSettings, RefineSettings, StartPolicy,
+    AlgebraicSettings, Method, MethodName, ModelChoice, ModulatingSettings, RefineSettings,
+    StartPolicy,
 };
 pub use plausibility::{DISPLACEMENT_MAX_M, DISPLACEMENT_MIN_M, NOISE_TO_SIGNAL_MAX};
 pub use record::{rebased, Record, Speed, SpeedSource, CONSTANT_PHI_TOLERANCE};
@@ -230,16 +231,16 @@ fn unphysical(params: &[ParameterResult]) -> Vec<Diagnostic> {
 /// The rotor of per-direction results, when all are determined (m: mean of m_x, m_z).
 fn rotor_of(k: &Knowledge, params: &[ParameterResult]) -> Option<RotorSummary> {
     let v: Vec<f64> = params.iter().map(|r| r.value).collect::<Option<_>>()?;
-    Some(RotorSummary {
+    Some(RotorSummary::of(&crate::model::RotorParams {
         m: 0.5 * (v[0] + v[3]),
         cx: v[1],
         kx: v[2],
         cz: v[4],
         kz: v[5],
         a: k.a,
-        mud: k.unbalance.mud(),
-        alpha: k.unbalance.alpha,
-    })
+        unbalance: k.unbalance,
+        coupling: None,
+    }))
 }
 
 fn algebraic_identification(
@@ -296,6 +297,8 @@ fn algebraic_identification(
     Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Algebraic,
+        model: crate::parameter::ModelKind::Jeffcott,
+        model_selection: None,
         input: None,
         scenario: None,
         record,
@@ -394,6 +397,8 @@ fn modulating_identification(
     Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Modulating,
+        model: crate::parameter::ModelKind::Jeffcott,
+        model_selection: None,
         input: None,
         scenario: None,
         record,

@@ -3,27 +3,38 @@
 //! meaningful, and the rule that withholds what the record does not determine.
 //!
 //! A parameter is determined when its standard error is finite and no larger than its
-//! value (alpha: no larger than 1 rad), and the data separate the unknowns (no not-identifiable or ill-conditioned
-//! finding) and the model explains the record (module `adequacy`). The bound is evaluated at the truth when the caller knows all of m, c, k
-//! (with the true initial state when the record starts at t = 0, else the fitted one),
-//! otherwise at the estimate; always with the fitted noise.
+//! value (alpha: no larger than 1 rad; a cross-coupled coefficient, which may be 0: no
+//! larger than the direct coefficients it couples, `FittedValue::scale`), and the data
+//! separate the unknowns (no not-identifiable or ill-conditioned finding) and the model
+//! explains the record (module `adequacy`). The bound is evaluated at the truth when the
+//! caller knows every mass, damping and stiffness value of the model (with the true initial
+//! state when the record starts at t = 0, else the fitted one), otherwise at the estimate;
+//! always with the fitted noise.
+//!
+//! The model is the settings' (docs/method.md section 6.6): one fixed model, or `auto`:
+//! the Jeffcott and the cross-coupled model fitted in turn (the second started from the
+//! first's estimate, the nested Jeffcott rotor), each judged by its residuals, and the
+//! simplest adequate one taken by the Bayesian information criterion. A fixed Jeffcott fit
+//! that its residuals reject is followed by a cross-coupled fit; when that one explains the
+//! record, a note says so.
 
 use crate::model::{InitialState, RotorParams};
-use crate::parameter::Parameter;
+use crate::parameter::{ModelKind, Parameter};
 use crate::refine::{
-    crb, model_response, refine, Discretisation, RefineOptions, Refined, Unknowns, ALPHA_STD_LIMIT,
+    crb, model_response, refine, Discretisation, FittedValue, RefineOptions, Refined, Unknowns,
+    ALPHA_STD_LIMIT,
 };
 
 use super::adequacy::Adequacy;
-use super::diagnostic::{Diagnostic, Finding};
+use super::diagnostic::{Diagnostic, Direction, Directions, Finding};
 use super::error::PipelineError;
 use super::identification::StartSource;
 use super::identification::{
-    finite, Covariance, CrbAt, Identification, Noise, NoiseSource, ParameterResult, RefineDetail,
-    RotorSummary, StateResult, IDENTIFICATION_SCHEMA,
+    finite, Covariance, CrbAt, Identification, ModelCandidate, ModelSelection, Noise, NoiseSource,
+    ParameterResult, RefineDetail, RotorSummary, StateResult, IDENTIFICATION_SCHEMA,
 };
 use super::knowledge::Knowledge;
-use super::method::{MethodName, RefineSettings, StartPolicy};
+use super::method::{MethodName, ModelChoice, RefineSettings, StartPolicy};
 use super::modulating_detail;
 use super::record::Record;
 use super::start::{self, check_known};
@@ -45,16 +56,290 @@ pub(crate) fn run(
             why: "the algebraic identifier that may give the start needs them",
         });
     }
-    let u = s.unknowns;
-    check_known(k, &u)?;
-    let found = match s.start {
-        StartPolicy::Auto => start::find(rec, k, s)?,
-        StartPolicy::Given(p) => start::Found {
-            start: start::start(StartSource::Given, None, &p, None),
-            params: p,
+    let choice = s.model.unwrap_or(ModelChoice::from(k.model));
+    let model = match (choice, s.start) {
+        (ModelChoice::Auto, StartPolicy::Given(p)) => {
+            return Err(PipelineError::GivenStartNeedsModel {
+                model: p.model().name(),
+            })
+        }
+        (ModelChoice::Auto, StartPolicy::Auto) => return select(rec, k, s),
+        (choice, _) => choice.fixed().expect("not auto"),
+    };
+    let u = unknowns(s, model, false);
+    let (mut ident, _) = fit(rec, k, s, model, &u, None)?;
+    if model == ModelKind::Jeffcott && inadequate(&ident) && !u.any_cross() {
+        // does the cross-coupled model explain what the Jeffcott one cannot?
+        let cu = cross_unknowns(&u);
+        let start = ident_rotor(&ident);
+        if let Ok((alt, _)) = fit(rec, k, s, ModelKind::CrossCoupled, &cu, start.as_ref()) {
+            if alt.adequacy.is_some_and(|a| a.model_adequate) {
+                ident
+                    .diagnostics
+                    .push(Diagnostic::note(Finding::OtherModelExplains {
+                        model: ModelKind::CrossCoupled,
+                        bic_difference: bic(&ident) - bic(&alt),
+                    }));
+            }
+        }
+    }
+    Ok(ident)
+}
+
+/// The unknowns of `model` under settings `s` (module doc of [`RefineSettings::unknowns`]);
+/// `auto` when the model is a candidate of `--model auto`.
+fn unknowns(s: &RefineSettings, model: ModelKind, auto: bool) -> Unknowns {
+    match (s.unknowns, model) {
+        (None, m) => Unknowns::for_model(m),
+        (Some(u), ModelKind::Jeffcott) if auto => Unknowns {
+            cxz: false,
+            czx: false,
+            kxz: false,
+            kzx: false,
+            ..u
+        },
+        (Some(u), ModelKind::CrossCoupled) if auto => cross_unknowns(&u),
+        (Some(u), _) => u,
+    }
+}
+
+/// `u` with the four cross-coupled coefficients when it has none.
+fn cross_unknowns(u: &Unknowns) -> Unknowns {
+    if u.any_cross() {
+        *u
+    } else {
+        Unknowns {
+            cxz: true,
+            czx: true,
+            kxz: true,
+            kzx: true,
+            ..*u
+        }
+    }
+}
+
+/// True when the residual tests rejected the fit.
+fn inadequate(ident: &Identification) -> bool {
+    ident.adequacy.is_some_and(|a| !a.model_adequate)
+}
+
+/// The fitted rotor of an identification (estimates whether determined or not), for the
+/// start of a larger model.
+fn ident_rotor(ident: &Identification) -> Option<RotorParams> {
+    let start = ident.refine.as_ref()?.start.values.params();
+    let mut p = start;
+    for r in &ident.parameters {
+        if let Some(v) = r.estimate {
+            if r.parameter != Parameter::Alpha && r.parameter != Parameter::Mud {
+                p.set(r.parameter, v);
+            }
+        }
+    }
+    Some(p)
+}
+
+/// The Gaussian log-likelihood of x and z at the fit's noise levels (module doc of
+/// [`ModelCandidate`]): -N/2 (ln(2 pi sigma_x^2) + 1) - N/2 (ln(2 pi sigma_z^2) + 1).
+fn log_likelihood(ident: &Identification) -> f64 {
+    let n = ident.record.samples as f64;
+    let Some(noise) = ident.noise else {
+        return f64::NAN;
+    };
+    let term = |s: f64| {
+        let v = (s * s).max(f64::MIN_POSITIVE);
+        -0.5 * n * ((std::f64::consts::TAU * v).ln() + 1.0)
+    };
+    term(noise.sigma_x_m) + term(noise.sigma_z_m)
+}
+
+/// Quantities a fit estimated: its covariance's rows and the two noise levels.
+fn estimated(ident: &Identification) -> u64 {
+    ident
+        .covariance
+        .as_ref()
+        .map_or(0, |c| c.names.len() as u64)
+        + 2
+}
+
+/// BIC = -2 ln L + (estimated) ln(2 N).
+fn bic(ident: &Identification) -> f64 {
+    let n = 2.0 * ident.record.samples as f64;
+    -2.0 * log_likelihood(ident) + estimated(ident) as f64 * n.ln()
+}
+
+/// `--model auto` (module doc).
+fn select(
+    rec: &Record,
+    k: &Knowledge,
+    s: &RefineSettings,
+) -> Result<Identification, PipelineError> {
+    let uj = unknowns(s, ModelKind::Jeffcott, true);
+    let (jeffcott, _) = fit(rec, k, s, ModelKind::Jeffcott, &uj, None)?;
+    let uc = unknowns(s, ModelKind::CrossCoupled, true);
+    let start = ident_rotor(&jeffcott).filter(|p| {
+        p.m > 0.0 && p.kx > 0.0 && p.kz > 0.0 && [p.cx, p.cz].iter().all(|c| c.is_finite())
+    });
+    let cross = fit(rec, k, s, ModelKind::CrossCoupled, &uc, start.as_ref()).map(|(i, _)| i);
+    let mut fits = vec![jeffcott];
+    let mut notes = Vec::new();
+    match cross {
+        Ok(c) => fits.push(c),
+        Err(e) => notes.push(format!("the cross-coupled model could not be fitted: {e}")),
+    }
+    let candidates: Vec<ModelCandidate> = fits
+        .iter()
+        .map(|f| ModelCandidate {
+            model: f.model,
+            estimated: estimated(f),
+            log_likelihood: log_likelihood(f),
+            bic: bic(f),
+            adequate: f.adequacy.map(|a| a.model_adequate),
+            noise_ratio: Directions {
+                x: f.adequacy.map_or(f64::NAN, |a| a.x.noise_ratio),
+                z: f.adequacy.map_or(f64::NAN, |a| a.z.noise_ratio),
+            },
+            converged: f.refine.as_ref().is_some_and(|r| r.converged),
+            identifiable: f.identifiable(),
+        })
+        .collect();
+    let ok = |c: &ModelCandidate| c.adequate == Some(true) && c.converged;
+    let pool: Vec<usize> = if candidates.iter().any(ok) {
+        (0..candidates.len())
+            .filter(|&i| ok(&candidates[i]))
+            .collect()
+    } else {
+        (0..candidates.len()).collect()
+    };
+    let best = pool
+        .iter()
+        .copied()
+        .min_by(|&a, &b| candidates[a].bic.total_cmp(&candidates[b].bic))
+        .expect("the Jeffcott candidate is always there");
+    let reason = selection_reason(&candidates, best, &notes);
+    let mut ident = fits.swap_remove(best);
+    ident
+        .diagnostics
+        .push(Diagnostic::note(Finding::ModelSelected {
+            model: ident.model,
+            reason: reason.clone(),
+        }));
+    ident.model_selection = Some(ModelSelection {
+        criterion: "among the candidates whose residuals pass the adequacy test (all when none \
+                    does), the lowest BIC = -2 ln L + k ln(2 N)"
+            .to_owned(),
+        chosen: candidates[best].model,
+        candidates,
+        reason,
+    });
+    Ok(ident)
+}
+
+/// The selection in words.
+fn selection_reason(c: &[ModelCandidate], best: usize, notes: &[String]) -> String {
+    let name = |m: ModelKind| match m {
+        ModelKind::Jeffcott => "the Jeffcott model",
+        ModelKind::CrossCoupled => "the cross-coupled model",
+    };
+    let judged = |x: &ModelCandidate| {
+        match x.adequate {
+        Some(true) => "its residuals look like the data's noise".to_owned(),
+        Some(false) => format!(
+            "its residuals fail the adequacy test (residual {:.2}x / {:.2}x the noise level in x / z)",
+            x.noise_ratio.x, x.noise_ratio.z
+        ),
+        None => "its residuals could not be tested".to_owned(),
+    }
+    };
+    let b = &c[best];
+    let mut out = String::new();
+    if b.model == ModelKind::CrossCoupled
+        && c[0].adequate == Some(false)
+        && b.adequate == Some(true)
+    {
+        out.push_str("cross-coupled bearings explain these data: ");
+    }
+    if b.adequate != Some(true) {
+        out.push_str("no candidate model explains these data (its values are withheld): ");
+    }
+    out.push_str(&format!("{} was taken, {}", name(b.model), judged(b)));
+    for (i, x) in c.iter().enumerate().filter(|&(i, _)| i != best) {
+        let _ = i;
+        out.push_str(&format!(
+            "; {} {}, BIC {} by {:.1}",
+            name(x.model),
+            judged(x),
+            if x.bic > b.bic { "higher" } else { "lower" },
+            (x.bic - b.bic).abs()
+        ));
+    }
+    for n in notes {
+        out.push_str("; ");
+        out.push_str(n);
+    }
+    out
+}
+
+/// Whether `e` counts as determined by its standard error (module doc).
+pub(crate) fn small_enough(p: Parameter, e: &FittedValue) -> bool {
+    match (p, e.scale) {
+        (Parameter::Alpha, _) => e.std_error <= ALPHA_STD_LIMIT,
+        (_, Some(scale)) => e.std_error <= scale,
+        _ => e.relative_std_error.is_some_and(|r| r <= 1.0),
+    }
+}
+
+/// One fit of `model` with unknowns `u`, started from `start` when given (else by the
+/// start policy), as a whole identification.
+fn fit(
+    rec: &Record,
+    k: &Knowledge,
+    s: &RefineSettings,
+    model: ModelKind,
+    u: &Unknowns,
+    start: Option<&RotorParams>,
+) -> Result<(Identification, Refined), PipelineError> {
+    let u = *u;
+    check_known(k, &u, model)?;
+    let found = match (start, s.start) {
+        (Some(p), _) => start::Found {
+            start: start::start(
+                StartSource::Nominal,
+                None,
+                &start::with_cross(p, k, &u),
+                None,
+            ),
+            params: if model == ModelKind::CrossCoupled {
+                start::with_cross(p, k, &u)
+            } else {
+                RotorParams {
+                    coupling: None,
+                    ..*p
+                }
+            },
             modulating: None,
         },
+        (None, StartPolicy::Auto) => start::find(rec, k, s, &u, model)?,
+        (None, StartPolicy::Given(p)) => {
+            let p = match model {
+                ModelKind::CrossCoupled => start::with_cross(&p, k, &u),
+                ModelKind::Jeffcott => RotorParams {
+                    coupling: None,
+                    ..p
+                },
+            };
+            start::Found {
+                start: start::start(StartSource::Given, None, &p, None),
+                params: p,
+                modulating: None,
+            }
+        }
     };
+    let mut found = found;
+    if start.is_some() {
+        // the nested model's estimate
+        found.start.source = StartSource::NestedModel;
+        found.start.values = RotorSummary::of(&found.params);
+    }
     let record = rec.for_refine();
     let options = RefineOptions {
         unknowns: u,
@@ -87,12 +372,7 @@ pub(crate) fn run(
         .filter_map(|e| {
             let p: Parameter = e.name.parse().ok()?;
             let rel = e.relative_std_error;
-            // an angle has no relative error: alpha is determined to within 1 rad
-            let small = match p {
-                Parameter::Alpha => e.std_error <= ALPHA_STD_LIMIT,
-                _ => rel.is_some_and(|r| r <= 1.0),
-            };
-            let determined = e.std_error.is_finite() && small && !inseparable;
+            let determined = e.std_error.is_finite() && small_enough(p, e) && !inseparable;
             let truth = k.truth_of(p);
             let value = determined.then_some(e.value);
             Some(ParameterResult {
@@ -127,6 +407,8 @@ pub(crate) fn run(
     let mut ident = Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Refine,
+        model,
+        model_selection: None,
         input: None,
         scenario: None,
         record: super::record_info(rec),
@@ -146,7 +428,7 @@ pub(crate) fn run(
             .as_ref()
             .map(|e| modulating_detail(e, s.modulating.config.rcond_min)),
         refine: Some(RefineDetail {
-            unknowns: unknown_parameters(&u),
+            unknowns: u.parameters(model),
             start: found.start,
             initial_state: fit
                 .initial_state
@@ -174,7 +456,7 @@ pub(crate) fn run(
         estimates: Vec::new(),
     };
     super::apply_speed_check(&mut ident, &check);
-    Ok(ident)
+    Ok((ident, fit))
 }
 
 /// The residual tests of the fit (module `adequacy`); `None` when the model response
@@ -199,23 +481,6 @@ pub(crate) fn relative_error(value: Option<f64>, truth: Option<f64>) -> Option<f
     }
 }
 
-/// The unknowns as parameters (the unbalance as mud and alpha).
-fn unknown_parameters(u: &Unknowns) -> Vec<Parameter> {
-    [
-        (u.m, Parameter::M),
-        (u.cx, Parameter::Cx),
-        (u.kx, Parameter::Kx),
-        (u.cz, Parameter::Cz),
-        (u.kz, Parameter::Kz),
-        (u.a, Parameter::A),
-        (u.unbalance, Parameter::Mud),
-        (u.unbalance, Parameter::Alpha),
-    ]
-    .into_iter()
-    .filter_map(|(on, p)| on.then_some(p))
-    .collect()
-}
-
 fn covariance(fit: &Refined) -> Covariance {
     Covariance {
         names: fit
@@ -238,7 +503,7 @@ fn bound(
     fit: &Refined,
     u: &Unknowns,
 ) -> Result<(crate::refine::Crb, CrbAt), PipelineError> {
-    let (rotor, initial, at) = match true_rotor(k) {
+    let (rotor, initial, at) = match true_rotor(k, fit.rotor.model()) {
         Some((r, Some(ic))) if rec.grid().t0 == 0.0 => (r, ic, CrbAt::Truth),
         Some((r, _)) => (r, fit.initial, CrbAt::TruthParameters),
         None => (fit.rotor, fit.initial, CrbAt::Estimate),
@@ -269,11 +534,12 @@ pub(crate) fn modulating_bound(
     sigma_x: f64,
     sigma_z: f64,
 ) -> Result<(crate::refine::Crb, CrbAt), PipelineError> {
-    let (rotor, known_ic, at) = match true_rotor(k) {
+    let (rotor, known_ic, at) = match true_rotor(k, ModelKind::Jeffcott) {
         Some((r, Some(ic))) if rec.grid().t0 == 0.0 => (r, Some(ic), CrbAt::Truth),
         Some((r, _)) => (r, None, CrbAt::TruthParameters),
         None => (
             RotorParams {
+                coupling: None,
                 m: 0.5 * (values[0] + values[3]),
                 cx: values[1],
                 kx: values[2],
@@ -290,16 +556,7 @@ pub(crate) fn modulating_bound(
     let initial = match known_ic {
         Some(ic) => ic,
         None => {
-            let only_initial_state = Unknowns {
-                m: false,
-                cx: false,
-                kx: false,
-                cz: false,
-                kz: false,
-                a: false,
-                unbalance: false,
-                initial_state: true,
-            };
+            let only_initial_state = Unknowns::initial_state_only();
             let options = RefineOptions {
                 unknowns: only_initial_state,
                 ..RefineOptions::default()
@@ -318,21 +575,22 @@ pub(crate) fn modulating_bound(
     Ok((b, at))
 }
 
-/// The true rotor and (when known) initial state, when the knowledge has all of m, c, k.
-fn true_rotor(k: &Knowledge) -> Option<(RotorParams, Option<InitialState>)> {
-    k.truth.as_ref().and_then(|t| {
-        let v = &t.values;
-        Some((
-            RotorParams {
-                m: v.m?,
-                cx: v.cx?,
-                kx: v.kx?,
-                cz: v.cz?,
-                kz: v.kz?,
-                a: k.a,
-                unbalance: k.unbalance,
-            },
-            t.initial,
-        ))
-    })
+/// The true rotor of `model` and (when known) initial state, when the knowledge has every
+/// mass, damping and stiffness value of the model.
+fn true_rotor(k: &Knowledge, model: ModelKind) -> Option<(RotorParams, Option<InitialState>)> {
+    let t = k.truth.as_ref()?;
+    let mut p = RotorParams {
+        m: 0.0,
+        cx: 0.0,
+        kx: 0.0,
+        cz: 0.0,
+        kz: 0.0,
+        a: k.a,
+        unbalance: k.unbalance,
+        coupling: (model == ModelKind::CrossCoupled).then(Default::default),
+    };
+    for &q in model.default_unknowns() {
+        p.set(q, t.values.get(q)?);
+    }
+    Some((p, t.initial))
 }

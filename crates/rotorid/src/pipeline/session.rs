@@ -194,6 +194,18 @@ impl Session {
         if let Method::Algebraic(s) = method {
             s.config()?;
         }
+        let model = match method {
+            Method::Algebraic(s) => s.model,
+            Method::Modulating(s) => s.model,
+            Method::Refine(_) => None,
+        }
+        .unwrap_or(knowledge.model);
+        if model != crate::parameter::ModelKind::Jeffcott && !matches!(method, Method::Refine(_)) {
+            return Err(PipelineError::ModelNotAvailable {
+                method: method.name().as_str(),
+                model: model.name(),
+            });
+        }
         let grid = match timing {
             Timing::Grid { grid, .. } => Some(grid),
             Timing::Fit { .. } => None,

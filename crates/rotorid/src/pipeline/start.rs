@@ -15,10 +15,17 @@
 //! well-conditioned direction and is finite, with m, kx, kz > 0 (a negative damping is
 //! raised to 0 by the fit itself). Known quantities, a and the unbalance come from the
 //! [`Knowledge`].
+//!
+//! The cross-coupled model starts from the same estimates of m and the direct
+//! coefficients, with its cross-coupled coefficients at their nominal values or, when none
+//! is given, 0: the Jeffcott rotor nested in it (the refinement's continuation reaches
+//! cross-coupling of several per cent of the direct stiffness from there; docs/method.md
+//! section 5.6).
 
 use crate::identify::algebraic::AlgebraicIdentifier;
 use crate::identify::modulating::{ModulatingEstimate, ModulatingIdentifier};
-use crate::model::RotorParams;
+use crate::model::{CrossCoupling, RotorParams};
+use crate::parameter::{ModelKind, Parameter};
 use crate::refine::Unknowns;
 
 use super::error::PipelineError;
@@ -44,12 +51,18 @@ fn nominal(k: &Knowledge) -> [Option<f64>; 5] {
     [n.m, n.cx, n.kx, n.cz, n.kz]
 }
 
-/// Every quantity the fit leaves known must have a nominal value.
-pub(crate) fn check_known(k: &Knowledge, u: &Unknowns) -> Result<(), PipelineError> {
-    let (unknown, nom) = (mck_unknown(u), nominal(k));
-    let missing: Vec<&str> = (0..5)
-        .filter(|&i| !unknown[i] && nom[i].is_none())
-        .map(|i| MCK[i])
+/// Every quantity the fit leaves known must have a nominal value (in `model`, whose
+/// names the message uses).
+pub(crate) fn check_known(
+    k: &Knowledge,
+    u: &Unknowns,
+    model: ModelKind,
+) -> Result<(), PipelineError> {
+    let missing: Vec<&str> = model
+        .default_unknowns()
+        .iter()
+        .filter(|&&p| !u.selects(p) && k.nominal.get(p).is_none())
+        .map(|p| p.name())
         .collect();
     if missing.is_empty() {
         Ok(())
@@ -70,13 +83,52 @@ pub(crate) struct Found {
 /// (m, c, k) of one direction, when well conditioned.
 type Direction = Option<[f64; 3]>;
 
-/// The start (module doc); an error only when no source is usable.
+/// The start of the fit of `u` in `model` (module doc); an error only when no source is
+/// usable.
 pub(crate) fn find(
     rec: &Record,
     k: &Knowledge,
     s: &RefineSettings,
+    u: &Unknowns,
+    model: ModelKind,
 ) -> Result<Found, PipelineError> {
-    let u = &s.unknowns;
+    let mut found = find_jeffcott(rec, k, s, u)?;
+    if model == ModelKind::CrossCoupled {
+        found.params = with_cross(&found.params, k, u);
+        found.start.values = RotorSummary::of(&found.params);
+    }
+    Ok(found)
+}
+
+/// `p` in the cross-coupled model: its cross-coupled coefficients at their nominal values
+/// where known, else 0.
+pub(crate) fn with_cross(p: &RotorParams, k: &Knowledge, u: &Unknowns) -> RotorParams {
+    let c = p.cross();
+    let nominal = |q: Parameter, default: f64| {
+        if u.selects(q) {
+            k.nominal.get(q).unwrap_or(default)
+        } else {
+            k.nominal.get(q).unwrap_or(0.0)
+        }
+    };
+    RotorParams {
+        coupling: Some(CrossCoupling {
+            cxz: nominal(Parameter::Cxz, c.cxz),
+            czx: nominal(Parameter::Czx, c.czx),
+            kxz: nominal(Parameter::Kxz, c.kxz),
+            kzx: nominal(Parameter::Kzx, c.kzx),
+        }),
+        ..*p
+    }
+}
+
+/// The start of m and the direct coefficients (module doc).
+fn find_jeffcott(
+    rec: &Record,
+    k: &Knowledge,
+    s: &RefineSettings,
+    u: &Unknowns,
+) -> Result<Found, PipelineError> {
     let mut notes = Vec::new();
     match modulating_start(rec, k, s) {
         Ok((est, dirs)) => match compose(dirs, u, k) {
@@ -142,6 +194,7 @@ pub(crate) fn start(
 /// Rotor parameters with m, cx, kx, cz, kz from `mck` and a, unbalance from `k`.
 fn with_mck(mck: [f64; 5], k: &Knowledge) -> RotorParams {
     RotorParams {
+        coupling: None,
         m: mck[0],
         cx: mck[1],
         kx: mck[2],

@@ -38,10 +38,7 @@ pub fn crb(
     initial.validated()?;
     check("sigma_x", sigma_x, "finite and > 0 (m)", |v| v > 0.0)?;
     check("sigma_z", sigma_z, "finite and > 0 (m)", |v| v > 0.0)?;
-    let cols = Columns::new(unknowns);
-    if cols.n == 0 {
-        return Err(RefineError::NoUnknowns);
-    }
+    let cols = super::lm::columns(unknowns, rotor)?;
     let t = Theta::new(rotor, initial);
     let disc = Discrete::new(experiment, Discretisation::Auto, &t)?;
     let mut sink = NormalSink {
@@ -134,16 +131,7 @@ pub fn model_response(
     initial.validated()?;
     let t = Theta::new(rotor, initial);
     let disc = Discrete::new(experiment, discretisation, &t)?;
-    let cols = Columns::new(&Unknowns {
-        m: false,
-        cx: false,
-        kx: false,
-        cz: false,
-        kz: false,
-        a: false,
-        unbalance: false,
-        initial_state: false,
-    });
+    let cols = Columns::new(&Unknowns::from_parameters(&[], false), rotor.model());
     let mut sink = ResponseSink {
         x: Vec::with_capacity(experiment.samples),
         z: Vec::with_capacity(experiment.samples),

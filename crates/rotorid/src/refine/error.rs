@@ -53,6 +53,13 @@ pub enum RefineError {
     /// The model description is invalid.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// Cross-coupled coefficients were asked for, but the start is a Jeffcott rotor (no
+    /// cross-coupling): the model has no such parameters.
+    #[error("the unknowns {unknowns} are cross-coupled coefficients, which the Jeffcott model does not have: start from a cross-coupled rotor (RotorParams::coupling)")]
+    CrossUnknownsNeedCrossModel {
+        /// The cross-coupled unknowns asked for, comma-separated.
+        unknowns: String,
+    },
 }
 
 /// First non-finite entry of `v`, as [`RefineError::NonFinite`].

@@ -6,13 +6,15 @@
 //! Y = (x, z, vx, vz, s, c):
 //!
 //! ```text
-//!       [   0      0      1      0      0        0     ]
-//!       [   0      0      0      1      0        0     ]
-//! A  =  [ -kx/m    0    -cx/m   aW/m   W^2 uc/m  W^2 us/m ]
-//!       [   0    -kz/m  -aW/m  -cz/m  -W^2 us/m  W^2 uc/m ]
-//!       [   0      0      0      0      0        W     ]
-//!       [   0      0      0      0     -W        0     ]
+//!       [    0       0         1             0          0        0     ]
+//!       [    0       0         0             1          0        0     ]
+//! A  =  [ -kx/m   -kxz/m    -cx/m     (aW - cxz)/m   W^2 uc/m  W^2 us/m ]
+//!       [ -kzx/m  -kz/m  -(aW + czx)/m   -cz/m     -W^2 us/m  W^2 uc/m ]
+//!       [    0       0         0             0          0        W     ]
+//!       [    0       0         0             0         -W        0     ]
 //! ```
+//!
+//! (the cross-coupled terms cxz, czx, kxz, kzx are 0 in the Jeffcott model).
 //!
 //! so the samples obey Y_k+1 = Phi Y_k exactly, Phi = exp(A dt): no discretisation error
 //! at all, only rounding. The sensitivity of Phi to a parameter theta_j is the Frechet
@@ -55,13 +57,16 @@ pub(crate) fn system_matrix(t: &Theta, w: f64) -> M6 {
     let mut a = M6::zeros();
     a[(0, 2)] = 1.0;
     a[(1, 3)] = 1.0;
+    // cross-coupled terms: 0 in the Jeffcott model, which leaves every entry bit for bit
     a[(2, 0)] = -t.kx * im;
+    a[(2, 1)] = -t.kxz * im;
     a[(2, 2)] = -t.cx * im;
-    a[(2, 3)] = t.a * w * im;
+    a[(2, 3)] = (t.a * w - t.cxz) * im;
     a[(2, 4)] = w2 * t.uc * im;
     a[(2, 5)] = w2 * t.us * im;
+    a[(3, 0)] = -t.kzx * im;
     a[(3, 1)] = -t.kz * im;
-    a[(3, 2)] = -t.a * w * im;
+    a[(3, 2)] = -(t.a * w + t.czx) * im;
     a[(3, 3)] = -t.cz * im;
     a[(3, 4)] = -w2 * t.us * im;
     a[(3, 5)] = w2 * t.uc * im;
@@ -86,6 +91,10 @@ fn direction(kind: Kind, a: &M6, t: &Theta, w: f64) -> M6 {
         Kind::Kx => e[(2, 0)] = -im,
         Kind::Cz => e[(3, 3)] = -im,
         Kind::Kz => e[(3, 1)] = -im,
+        Kind::Cxz => e[(2, 3)] = -im,
+        Kind::Czx => e[(3, 2)] = -im,
+        Kind::Kxz => e[(2, 1)] = -im,
+        Kind::Kzx => e[(3, 0)] = -im,
         Kind::A => {
             e[(2, 3)] = w * im;
             e[(3, 2)] = -w * im;
@@ -200,14 +209,28 @@ mod tests {
     use super::*;
     use crate::model::{InitialState, Rotor};
 
-    /// The Van Loan derivative agrees with a central difference of exp(A(theta) dt).
+    /// The Van Loan derivative agrees with a central difference of exp(A(theta) dt), for
+    /// every parameter of the cross-coupled model.
     #[test]
     fn frechet_derivative_matches_central_difference() {
-        let p = Rotor::table1().params();
-        let t0 = Theta::new(&p, &InitialState::default());
         let w = 125.0;
         let dt = 1e-4;
-        let cols = Columns::new(&super::super::Unknowns::all());
+        let mut p = Rotor::table1().params();
+        p.coupling = Some(crate::model::CrossCoupling {
+            cxz: 3.0,
+            czx: -2.0,
+            kxz: 1.0e5,
+            kzx: -1.2e5,
+        });
+        let t0 = Theta::new(&p, &InitialState::default());
+        let u = super::super::Unknowns {
+            cxz: true,
+            czx: true,
+            kxz: true,
+            kzx: true,
+            ..super::super::Unknowns::all()
+        };
+        let cols = Columns::new(&u, crate::parameter::ModelKind::CrossCoupled);
         let osc = [[0.0, 1.0]];
         let st = ExactStep::new(&t0, &cols, w, dt, &osc);
         for (j, &kind) in cols.kinds()[..cols.nphys].iter().enumerate() {

@@ -39,6 +39,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::model::{check, InitialState, RotorParams};
+use crate::parameter::ModelKind;
 
 use super::discretisation::{Discrete, Discretisation};
 use super::error::RefineError;
@@ -230,17 +231,23 @@ const MAX_RELATIVE_STEP: f64 = 0.5;
 const MIN_DAMPING_RATIO: f64 = -0.01;
 
 /// A trust region in physical terms: m, kx, kz change by at most 50 % per step (and m stays
-/// positive), cx, cz stay above a damping ratio of -0.01.
+/// positive), cx, cz stay above a damping ratio of -0.01; a cross-coupled stiffness
+/// changes by at most 50 % of sqrt(kx kz) and a cross-coupled damping by at most 50 % of
+/// the critical damping 2 sqrt(m sqrt(kx kz)) (a step beyond them makes the model grow
+/// exponentially or changes its modes beyond what the linearisation describes).
 fn plausible_step(cur: &Theta, trial: &Theta, cols: &Columns) -> bool {
     if trial.m.is_nan() || trial.m <= 0.0 {
         return false;
     }
-    cols.kinds()[..cols.nphys].iter().all(|&k| match k {
-        Kind::M | Kind::Kx | Kind::Kz => {
-            (trial.get(k) - cur.get(k)).abs() <= MAX_RELATIVE_STEP * cur.get(k).abs()
-        }
+    let k = (cur.kx * cur.kz).abs().sqrt();
+    let c_crit = 2.0 * (cur.m * k).sqrt();
+    let step = |kind: Kind| (trial.get(kind) - cur.get(kind)).abs();
+    cols.kinds()[..cols.nphys].iter().all(|&kind| match kind {
+        Kind::M | Kind::Kx | Kind::Kz => step(kind) <= MAX_RELATIVE_STEP * cur.get(kind).abs(),
         Kind::Cx => trial.cx >= MIN_DAMPING_RATIO * 2.0 * (trial.kx.abs() * trial.m).sqrt(),
         Kind::Cz => trial.cz >= MIN_DAMPING_RATIO * 2.0 * (trial.kz.abs() * trial.m).sqrt(),
+        Kind::Kxz | Kind::Kzx => step(kind) <= MAX_RELATIVE_STEP * k,
+        Kind::Cxz | Kind::Czx => step(kind) <= MAX_RELATIVE_STEP * c_crit,
         _ => true,
     })
 }
@@ -256,9 +263,11 @@ const WINDOW_MAX_PASSES: usize = 10;
 /// window, from the current window's covariance.
 const PHASE_BUDGET: f64 = 1.0;
 
-/// sqrt(max(kx, kz) / m) \[rad/s\] (0 when not finite).
+/// sqrt(k / m) \[rad/s\] with k = ||K||_inf = max(|kx| + |kxz|, |kzx| + |kz|) (max(kx, kz)
+/// for a Jeffcott rotor), 0 when not finite.
 fn natural_frequency(t: &Theta) -> f64 {
-    let w = (t.kx.abs().max(t.kz.abs()) / t.m).sqrt();
+    let k = (t.kx.abs() + t.kxz.abs()).max(t.kzx.abs() + t.kz.abs());
+    let w = (k / t.m).sqrt();
     if w.is_finite() {
         w
     } else {
@@ -346,10 +355,7 @@ pub fn refine(
         "finite and > 0 (standard errors)",
         |v| v > 0.0,
     )?;
-    let cols = Columns::new(&options.unknowns);
-    if cols.n == 0 {
-        return Err(RefineError::NoUnknowns);
-    }
+    let cols = columns(&options.unknowns, start)?;
     let samples = record.x.len();
     if samples < cols.n {
         return Err(RefineError::TooFewSamples {
@@ -454,6 +460,31 @@ pub fn refine(
     ))
 }
 
+/// The columns of `u` in the model of `start`; cross-coupled unknowns need a
+/// cross-coupled start.
+pub(crate) fn columns(u: &Unknowns, start: &RotorParams) -> Result<Columns, RefineError> {
+    let model = start.model();
+    if u.any_cross() && model == ModelKind::Jeffcott {
+        let cross: Vec<&str> = [
+            (u.cxz, "cxz"),
+            (u.czx, "czx"),
+            (u.kxz, "kxz"),
+            (u.kzx, "kzx"),
+        ]
+        .iter()
+        .filter_map(|(on, n)| on.then_some(*n))
+        .collect();
+        return Err(RefineError::CrossUnknownsNeedCrossModel {
+            unknowns: cross.join(", "),
+        });
+    }
+    let cols = Columns::new(u, model);
+    if cols.n == 0 {
+        return Err(RefineError::NoUnknowns);
+    }
+    Ok(cols)
+}
+
 struct Summary {
     sigma_x: f64,
     sigma_z: f64,
@@ -522,21 +553,24 @@ fn assemble(
             last_step: s.last_step,
         });
     }
-    let id_warnings = identifiability_warnings(&rs, fi.condition_number);
+    let mut id_warnings = identifiability_warnings(&rs, fi.condition_number);
+    if s.no_transient.is_some() {
+        for w in &mut id_warnings {
+            if let Warning::NotIdentifiable {
+                steady_state_only, ..
+            } = w
+            {
+                *steady_state_only = true;
+            }
+        }
+    }
     let identifiable = id_warnings.is_empty();
     warnings.extend(id_warnings);
-    for r in rs.iter().filter(|r| !r.initial) {
-        let bad = match r.name {
-            "m" | "kx" | "kz" => r.value <= 0.0,
-            "cx" | "cz" => r.value < 0.0,
-            _ => false,
-        };
-        if bad {
-            warnings.push(Warning::Unphysical {
-                parameter: r.name,
-                value: r.value,
-            });
-        }
+    for r in rs.iter().filter(|r| !r.initial && r.unphysical) {
+        warnings.push(Warning::Unphysical {
+            parameter: r.name,
+            value: r.value,
+        });
     }
     let mut parameters = Vec::new();
     let mut initial_state = Vec::new();
@@ -549,6 +583,7 @@ fn assemble(
             relative_std_error: r.relative,
             robust_std_error: robust_rows.as_ref().map(|rr| rr[i].std),
             start: r0.value,
+            scale: r.scale,
             crb: None,
         };
         if r.initial {
@@ -580,7 +615,7 @@ fn assemble(
         covariance: (0..n)
             .map(|i| fi.cov[i * n..(i + 1) * n].to_vec())
             .collect(),
-        covariance_names: cols.kinds().iter().map(|k| k.name()).collect(),
+        covariance_names: cols.kinds().iter().map(|k| k.name_in(cols.model)).collect(),
         robust: robust.map(|r| RobustCovariance {
             bandwidth: r.bandwidth,
             residual_lag1_autocorrelation: r.rho,

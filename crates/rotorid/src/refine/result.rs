@@ -16,6 +16,7 @@ use std::fmt;
 use serde::Serialize;
 
 use crate::model::{InitialState, RotorParams};
+use crate::parameter::Sign;
 
 use super::fisher::Fisher;
 use super::unknowns::{Columns, Kind, Theta};
@@ -49,6 +50,12 @@ pub struct FittedValue {
     pub robust_std_error: Option<f64>,
     /// Starting value of the fit \[unit\].
     pub start: f64,
+    /// For a coefficient whose true value may be zero or negative (a cross-coupled one):
+    /// the size \[unit\] its standard error must not exceed for it to count as determined,
+    /// from the direct coefficients (sqrt(kx kz) for kxz, kzx; the larger of sqrt(cx cz)
+    /// and 1 % of the critical damping 2 sqrt(m sqrt(kx kz)) for cxz, czx). `None` for the
+    /// others, whose standard error is compared with their value.
+    pub scale: Option<f64>,
     /// The Cramer-Rao bound at the true parameters and true noise \[unit\], when attached
     /// with [`Refined::attach_crb`] (simulation studies), else `None`.
     pub crb: Option<f64>,
@@ -63,6 +70,9 @@ pub enum Warning {
     NotIdentifiable {
         /// Names of the parameters concerned.
         parameters: Vec<&'static str>,
+        /// The record holds no significant free transient at constant speed: only the
+        /// steady-state response informs the fit (its message says what record would).
+        steady_state_only: bool,
     },
     /// The unknowns are so strongly correlated that the data barely separate them and the
     /// standard errors are numerically unreliable.
@@ -72,11 +82,13 @@ pub enum Warning {
         /// The limit it exceeds ([`CONDITION_LIMIT`]).
         limit: f64,
     },
-    /// The standard error exceeds the value itself (or 1 rad for alpha).
+    /// The standard error exceeds the value itself (or 1 rad for alpha; or, for a
+    /// cross-coupled coefficient, its scale [`FittedValue::scale`]).
     PoorlyDetermined {
         /// The parameter.
         parameter: &'static str,
-        /// Its standard error over its absolute value (for alpha: its standard error, rad).
+        /// Its standard error over its absolute value (for alpha: its standard error, rad;
+        /// for a cross-coupled coefficient: over its scale).
         relative_std_error: f64,
     },
     /// The iteration limit was reached before the step fell below the tolerance.
@@ -106,11 +118,23 @@ pub enum Warning {
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Warning::NotIdentifiable { parameters } => write!(
-                f,
-                "not identifiable from this record: {} (the data carry no information on them; values are arbitrary)",
-                parameters.join(", ")
-            ),
+            Warning::NotIdentifiable {
+                parameters,
+                steady_state_only,
+            } => {
+                write!(
+                    f,
+                    "not identifiable from this record: {} (the data carry no information on them; values are arbitrary)",
+                    parameters.join(", ")
+                )?;
+                if *steady_state_only {
+                    write!(
+                        f,
+                        ": a steady-state unbalance response at one speed gives two real equations per direction (the amplitude and phase of x and of z), which cannot separate mass, damping and stiffness, nor direct from cross-coupled bearing coefficients; a record with a start-up transient, a run-up or a coast-down can"
+                    )?;
+                }
+                Ok(())
+            }
             Warning::IllConditioned {
                 condition_number,
                 limit,
@@ -124,6 +148,11 @@ impl fmt::Display for Warning {
             } => {
                 if *parameter == "alpha" {
                     write!(f, "alpha is undetermined: standard error {relative_std_error:.3} rad")
+                } else if matches!(*parameter, "cxz" | "czx" | "kxz" | "kzx") {
+                    write!(
+                        f,
+                        "{parameter} is undetermined: standard error is {relative_std_error:.3e} times the size of the direct coefficients it couples"
+                    )
                 } else {
                     write!(
                         f,
@@ -288,6 +317,24 @@ pub(crate) struct Row {
     pub std: f64,
     pub initial: bool,
     pub relative: Option<f64>,
+    /// [`FittedValue::scale`].
+    pub scale: Option<f64>,
+    /// Outside the physical range of its parameter (m, a direct stiffness <= 0; a direct
+    /// damping < 0).
+    pub unphysical: bool,
+}
+
+/// The scale of a cross-coupled coefficient ([`FittedValue::scale`]) at `t`.
+fn cross_scale(k: Kind, t: &Theta) -> Option<f64> {
+    let stiffness = (t.kx * t.kz).abs().sqrt();
+    match k {
+        Kind::Kxz | Kind::Kzx => Some(stiffness),
+        Kind::Cxz | Kind::Czx => {
+            let critical = 2.0 * (t.m.abs() * stiffness).sqrt();
+            Some((t.cx * t.cz).abs().sqrt().max(0.01 * critical))
+        }
+        _ => None,
+    }
 }
 
 fn relative(std: f64, value: f64) -> f64 {
@@ -328,6 +375,8 @@ pub(crate) fn rows(t: &Theta, cols: &Columns, fi: &Fisher) -> Vec<Row> {
                     std: s_mud,
                     initial: false,
                     relative: Some(relative(s_mud, mud)),
+                    scale: None,
+                    unphysical: false,
                 });
                 out.push(Row {
                     name: "alpha",
@@ -336,6 +385,8 @@ pub(crate) fn rows(t: &Theta, cols: &Columns, fi: &Fisher) -> Vec<Row> {
                     std: s_alpha,
                     initial: false,
                     relative: None,
+                    scale: None,
+                    unphysical: false,
                 });
             }
             Kind::Us => {}
@@ -343,13 +394,20 @@ pub(crate) fn rows(t: &Theta, cols: &Columns, fi: &Fisher) -> Vec<Row> {
                 let initial = k.initial_index().is_some();
                 let v = t.get(k);
                 let s = fi.std(j);
+                let unphysical = match k.parameter(cols.model).map(|p| p.sign()) {
+                    Some(Sign::Positive) => v <= 0.0,
+                    Some(Sign::NonNegative) => v < 0.0,
+                    _ => false,
+                };
                 out.push(Row {
-                    name: k.name(),
+                    name: k.name_in(cols.model),
                     unit: k.unit(),
                     value: v,
                     std: s,
                     initial,
                     relative: if initial { None } else { Some(relative(s, v)) },
+                    scale: cross_scale(k, t),
+                    unphysical,
                 });
             }
         }
@@ -367,7 +425,10 @@ pub(crate) fn identifiability_warnings(rows: &[Row], condition_number: f64) -> V
         .collect();
     let any_unid = !unid.is_empty();
     if any_unid {
-        w.push(Warning::NotIdentifiable { parameters: unid });
+        w.push(Warning::NotIdentifiable {
+            parameters: unid,
+            steady_state_only: false,
+        });
     }
     if condition_number > CONDITION_LIMIT && !any_unid {
         w.push(Warning::IllConditioned {
@@ -381,6 +442,13 @@ pub(crate) fn identifiability_warnings(rows: &[Row], condition_number: f64) -> V
                 w.push(Warning::PoorlyDetermined {
                     parameter: r.name,
                     relative_std_error: r.std,
+                });
+            }
+        } else if let Some(scale) = r.scale {
+            if !(r.std <= scale) {
+                w.push(Warning::PoorlyDetermined {
+                    parameter: r.name,
+                    relative_std_error: r.std / scale,
                 });
             }
         } else if let Some(rel) = r.relative {

@@ -4,8 +4,8 @@
 //! State y = (x, z, vx, vz); eq. (1) solved for the accelerations:
 //!
 //! ```text
-//! ax = ( -kx x - cx vx + a w vz + a w' z + u_c g_xc + u_s g_xs ) / m
-//! az = ( -kz z - cz vz - a w vx          + u_c g_zc + u_s g_zs ) / m
+//! ax = ( -kx x - kxz z - cx vx - cxz vz + a w vz + a w' z + u_c g_xc + u_s g_xs ) / m
+//! az = ( -kz z - kzx x - cz vz - czx vx - a w vx          + u_c g_zc + u_s g_zs ) / m
 //! ```
 //!
 //! (g: the unbalance shape functions of `speed_table`). The sensitivity S_j = dy/dtheta_j
@@ -14,6 +14,7 @@
 //! ```text
 //! m: (-ax/m, -az/m)    cx: (-vx/m, 0)    kx: (-x/m, 0)    cz: (0, -vz/m)    kz: (0, -z/m)
 //! a: ((w vz + w' z)/m, -w vx/m)    u_c: (g_xc/m, g_zc/m)    u_s: (g_xs/m, g_zs/m)
+//! cxz: (-vz/m, 0)   kxz: (-z/m, 0)   czx: (0, -vx/m)   kzx: (0, -x/m)
 //! ```
 //!
 //! and zero for the initial-state columns (whose S starts at a unit vector). RK4 applied
@@ -36,10 +37,13 @@ use super::unknowns::{Columns, Kind, Theta, MAXP};
 pub(crate) const FREQ_TOL: f64 = 1e-9;
 
 /// Sub-steps per sample interval `dt` \[s\] so that (w_ref dt / n)^4 / 120 <= FREQ_TOL,
-/// w_ref = max(sqrt(max(kx, kz)/m) + |a| w_max / (2m), w_max) (the forward whirl
-/// frequency bound and the forcing frequency) \[rad/s\].
+/// w_ref = max(sqrt(k/m) + |a| w_max / (2m), w_max) (the forward whirl frequency bound
+/// and the forcing frequency) \[rad/s\], k = ||K||_inf = max(|kx| + |kxz|, |kzx| + |kz|)
+/// (max(kx, kz) for a Jeffcott rotor).
 pub(crate) fn substeps_for(t: &Theta, w_max: f64, dt: f64) -> usize {
-    let wn = (t.kx.abs().max(t.kz.abs()) / t.m).sqrt() + t.a.abs() * w_max / (2.0 * t.m);
+    // ||K||_inf bounds the stiffness matrix's eigenvalues (max(kx, kz) without coupling)
+    let k = (t.kx.abs() + t.kxz.abs()).max(t.kzx.abs() + t.kz.abs());
+    let wn = (k / t.m).sqrt() + t.a.abs() * w_max / (2.0 * t.m);
     let w_ref = wn.max(w_max);
     let h_max = (120.0 * FREQ_TOL).powf(0.25) / w_ref;
     let n = (dt / h_max).ceil();
@@ -105,17 +109,21 @@ impl<'a> Rk4Step<'a> {
         let t = &self.t;
         let im = self.inv_m;
         let y = *ty;
-        let aw = t.a * p.w;
-        let awd = t.a * p.wd;
+        // the coefficients of z' and z in x'', of x' and x in z'' (cross-coupled terms 0 in
+        // the Jeffcott model, which leaves each bit for bit)
+        let aw = t.a * p.w - t.cxz;
+        let awd = t.a * p.wd - t.kxz;
+        let awz = t.a * p.w + t.czx;
+        let kzx = t.kzx;
         let fx = t.uc * p.gxc + t.us * p.gxs;
         let fz = t.uc * p.gzc + t.us * p.gzs;
         let ax = im * (-t.kx * y[0] - t.cx * y[2] + aw * y[3] + awd * y[1] + fx);
-        let az = im * (-t.kz * y[1] - t.cz * y[3] - aw * y[2] + fz);
+        let az = im * (-t.kz * y[1] - t.cz * y[3] - awz * y[2] - kzx * y[0] + fz);
         let dy = [y[2], y[3], ax, az];
         for j in 0..self.n {
             let q = ts[j];
             let mut ex = im * (-t.kx * q[0] - t.cx * q[2] + aw * q[3] + awd * q[1]);
-            let mut ez = im * (-t.kz * q[1] - t.cz * q[3] - aw * q[2]);
+            let mut ez = im * (-t.kz * q[1] - t.cz * q[3] - awz * q[2] - kzx * q[0]);
             match self.kinds[j] {
                 Kind::M => {
                     ex -= ax * im;
@@ -125,6 +133,10 @@ impl<'a> Rk4Step<'a> {
                 Kind::Kx => ex -= y[0] * im,
                 Kind::Cz => ez -= y[3] * im,
                 Kind::Kz => ez -= y[1] * im,
+                Kind::Cxz => ex -= y[3] * im,
+                Kind::Czx => ez -= y[2] * im,
+                Kind::Kxz => ex -= y[1] * im,
+                Kind::Kzx => ez -= y[0] * im,
                 Kind::A => {
                     ex += (p.w * y[3] + p.wd * y[1]) * im;
                     ez -= p.w * y[2] * im;

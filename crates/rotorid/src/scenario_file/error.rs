@@ -61,8 +61,9 @@ pub enum ScenarioFileError {
     },
     /// A key that its section does not have.
     #[error(
-        "{}: unknown key {section}.{key}; allowed keys in [{section}]: {allowed}",
-        At(origin, line)
+        "{}: unknown key {section}.{key}; allowed keys in [{section}]: {allowed}{}",
+        At(origin, line),
+        hint.as_deref().map_or(String::new(), |h| format!(" ({h})"))
     )]
     UnknownKey {
         /// The file name.
@@ -75,6 +76,9 @@ pub enum ScenarioFileError {
         key: String,
         /// The section's keys, comma-separated.
         allowed: String,
+        /// Where the key belongs, when it is another model's
+        /// (`kxx is a key of rotor.model = "cross_coupled"`).
+        hint: Option<String>,
     },
     /// A value of the wrong TOML type (`rotor.m = "heavy"`).
     #[error(
@@ -119,6 +123,41 @@ pub enum ScenarioFileError {
         line: Option<usize>,
         /// The model's message.
         message: String,
+    },
+    /// The cross-coupled bearings' damping matrix would feed energy into the rotor.
+    #[error(
+        "{}: rotor: the damping matrix [[cxx, cxz], [czx, czz]] = [[{cxx}, {cxz}], [{czx}, \
+         {czz}]] N s/m is not dissipative: its symmetric part must be positive semi-definite, \
+         i.e. cxx >= 0, czz >= 0 and cxx czz >= ((cxz + czx) / 2)^2",
+        At(origin, line)
+    )]
+    DampingNotDissipative {
+        /// The file name.
+        origin: String,
+        /// The line of the `[rotor]` section.
+        line: Option<usize>,
+        /// rotor.cxx \[N s/m\].
+        cxx: f64,
+        /// rotor.cxz \[N s/m\].
+        cxz: f64,
+        /// rotor.czx \[N s/m\].
+        czx: f64,
+        /// rotor.czz \[N s/m\].
+        czz: f64,
+    },
+    /// `rotor.model` is a string but not a model.
+    #[error(
+        "{}: rotor.model = \"{value}\" is not a rotor model: must be \"jeffcott\" or \
+         \"cross_coupled\"",
+        At(origin, line)
+    )]
+    UnknownModel {
+        /// The file name.
+        origin: String,
+        /// The line of the key.
+        line: Option<usize>,
+        /// The string written.
+        value: String,
     },
     /// `speed.kind` is a string but not a speed profile.
     #[error(
@@ -252,7 +291,9 @@ impl ScenarioFileError {
             | Self::MissingSpeedKind { origin, .. }
             | Self::MissingSpeedKey { origin, .. }
             | Self::MissingSamplingKey { origin, .. }
-            | Self::MissingKey { origin, .. } => origin,
+            | Self::MissingKey { origin, .. }
+            | Self::DampingNotDissipative { origin, .. }
+            | Self::UnknownModel { origin, .. } => origin,
         }
     }
 
@@ -270,7 +311,9 @@ impl ScenarioFileError {
             | Self::SpeedKeyNotApplicable { line, .. }
             | Self::MissingSpeedKind { line, .. }
             | Self::MissingSpeedKey { line, .. }
-            | Self::MissingKey { line, .. } => *line,
+            | Self::MissingKey { line, .. }
+            | Self::DampingNotDissipative { line, .. }
+            | Self::UnknownModel { line, .. } => *line,
             Self::MissingSection { .. }
             | Self::MissingRotorKey { .. }
             | Self::MissingSamplingKey { .. } => None,
@@ -306,6 +349,16 @@ impl ScenarioFileError {
                 line,
                 message,
             },
+            ModelError::DampingNotDissipative { cxx, cxz, czx, czz } => {
+                Self::DampingNotDissipative {
+                    origin: origin.to_owned(),
+                    line,
+                    cxx,
+                    cxz,
+                    czx,
+                    czz,
+                }
+            }
         }
     }
 }

@@ -29,6 +29,15 @@
 //! vx = 0.0         # m/s        (vz likewise)
 //! ```
 //!
+//! `rotor.model` chooses the rotor model (docs/method.md section 1.6): `"jeffcott"` (the
+//! default, the keys above) or `"cross_coupled"`, the same rotor on bearings with all eight
+//! coefficients, whose keys are m, a, kxx, kxz, kzx, kzz (N/m), cxx, cxz, czx, czz (N s/m),
+//! m_u, d, alpha_deg. Cross terms may have any sign; the direct stiffnesses must be > 0 and
+//! the damping matrix's symmetric part positive semi-definite. A caller may override the
+//! model ([`ScenarioSpec::with_model`], `--model`): a Jeffcott rotor is the cross-coupled
+//! one with zero cross terms, and a cross-coupled rotor's direct coefficients are the
+//! Jeffcott model's cx, kx, cz, kz.
+//!
 //! Any form of TOML that names the same keys is the same file: dotted keys
 //! (`rotor.m = 14.29`, `speed.kind = "constant"` at the top), inline tables
 //! (`sampling = { dt = 1.0e-4, duration = 1.0 }`) and sections may be mixed, one form per
@@ -66,13 +75,15 @@ use std::fmt;
 
 pub use error::ScenarioFileError;
 
-use crate::model::ModelError;
+use crate::model::{CrossCoupling, ModelError};
+use crate::parameter::ModelKind;
 use crate::{InitialState, Rotor, RotorParams, Sampling, Scenario, SpeedProfile, Unbalance};
 
 /// The name of the built-in scenario, the paper's Table 1 ([`Scenario::table1`]).
 pub const BUILTIN_TABLE1: &str = "table1";
 
-/// Keys allowed in each section, with the unit shown in messages.
+/// Keys allowed in each section, with the unit shown in messages. `[rotor]` also takes
+/// `model` (a string) and, with `model = "cross_coupled"`, [`CROSS_ROTOR_KEYS`] instead.
 const ROTOR_KEYS: [(&str, &str); 9] = [
     ("m", "kg"),
     ("cx", "N s/m"),
@@ -84,6 +95,47 @@ const ROTOR_KEYS: [(&str, &str); 9] = [
     ("d", "m"),
     ("alpha_deg", "deg"),
 ];
+/// The keys of `[rotor]` in the cross-coupled model.
+const CROSS_ROTOR_KEYS: [(&str, &str); 13] = [
+    ("m", "kg"),
+    ("a", "N s^2/m"),
+    ("kxx", "N/m"),
+    ("kxz", "N/m"),
+    ("kzx", "N/m"),
+    ("kzz", "N/m"),
+    ("cxx", "N s/m"),
+    ("cxz", "N s/m"),
+    ("czx", "N s/m"),
+    ("czz", "N s/m"),
+    ("m_u", "kg"),
+    ("d", "m"),
+    ("alpha_deg", "deg"),
+];
+/// Every value of `[rotor]` is kept under one name whatever the model calls it: the
+/// direct coefficients under the Jeffcott model's names (cxx is kept as cx).
+const CANONICAL: [(&str, &str); 4] = [("cxx", "cx"), ("czz", "cz"), ("kxx", "kx"), ("kzz", "kz")];
+/// The keys of `[rotor]` of `model`.
+fn rotor_keys(model: ModelKind) -> &'static [(&'static str, &'static str)] {
+    match model {
+        ModelKind::Jeffcott => &ROTOR_KEYS,
+        ModelKind::CrossCoupled => &CROSS_ROTOR_KEYS,
+    }
+}
+/// The name a value is kept under (module doc of [`CANONICAL`]).
+fn canonical(key: &'static str) -> &'static str {
+    CANONICAL
+        .iter()
+        .find(|(k, _)| *k == key)
+        .map_or(key, |(_, c)| *c)
+}
+/// The key `model` writes for the value kept as `canonical`.
+fn written_key(model: ModelKind, canonical: &str) -> &'static str {
+    rotor_keys(model)
+        .iter()
+        .map(|(k, _)| *k)
+        .find(|k| self::canonical(k) == canonical)
+        .unwrap_or("?")
+}
 const SPEED_KEYS: [(&str, &str); 5] = [
     ("kind", "\"constant\" or \"ramp\""),
     ("rpm", "rev/min"),
@@ -137,6 +189,18 @@ impl Section {
     fn get(&self, key: &str) -> Option<Num> {
         self.keys.get(key).copied()
     }
+
+    /// The same values under their canonical names ([`CANONICAL`]).
+    fn canonical(self) -> Self {
+        Self {
+            line: self.line,
+            keys: self
+                .keys
+                .into_iter()
+                .map(|(k, v)| (canonical(k), v))
+                .collect(),
+        }
+    }
 }
 
 /// A scenario file parsed and range-checked key by key, not yet required to be complete.
@@ -146,6 +210,11 @@ impl Section {
 pub struct ScenarioSpec {
     origin: String,
     builtin: Option<Scenario>,
+    /// The rotor model (`rotor.model`, or the override of [`Self::with_model`]).
+    model: ModelKind,
+    /// The model the file's `[rotor]` keys are written in.
+    written_model: ModelKind,
+    /// The `[rotor]` values, under their canonical names ([`CANONICAL`]).
     rotor: Section,
     speed: Option<SpeedProfile>,
     sampling: Option<Section>,
@@ -172,44 +241,14 @@ pub struct SimulationOverrides {
 
 /// True values of the identified parameters, when the scenario states them (for reporting
 /// the identification error only; the identifier never sees them).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Truth {
-    /// m \[kg\] (common to both directions).
-    pub m: Option<f64>,
-    /// cx \[N s/m\].
-    pub cx: Option<f64>,
-    /// cz \[N s/m\].
-    pub cz: Option<f64>,
-    /// kx \[N/m\].
-    pub kx: Option<f64>,
-    /// kz \[N/m\].
-    pub kz: Option<f64>,
-}
-
-impl Truth {
-    /// All five values of a validated rotor.
-    pub fn from_rotor(r: &Rotor) -> Self {
-        Self {
-            m: Some(r.m()),
-            cx: Some(r.cx()),
-            cz: Some(r.cz()),
-            kx: Some(r.kx()),
-            kz: Some(r.kz()),
-        }
-    }
-
-    /// True when no parameter is known.
-    pub fn is_empty(&self) -> bool {
-        [self.m, self.cx, self.cz, self.kx, self.kz]
-            .iter()
-            .all(Option::is_none)
-    }
-}
+pub type Truth = crate::pipeline::RotorValues;
 
 /// What `identify` needs from a scenario: the known quantities of eq. (1), the optional
 /// truth, and the optional speed profile and sampling grid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IdentificationScenario {
+    /// The rotor model.
+    pub model: ModelKind,
     /// Gyroscopic coefficient a \[N s^2/m\].
     pub a: f64,
     /// Unbalance mass m_u \[kg\].
@@ -246,6 +285,8 @@ impl ScenarioSpec {
         Self {
             origin: origin.to_owned(),
             builtin: Some(scenario),
+            model: scenario.rotor.model(),
+            written_model: scenario.rotor.model(),
             rotor: Section::default(),
             speed: None,
             sampling: None,
@@ -271,12 +312,28 @@ impl ScenarioSpec {
         &self.origin
     }
 
+    /// The rotor model (`rotor.model`, default `jeffcott`, or the override).
+    pub fn model(&self) -> ModelKind {
+        self.model
+    }
+
+    /// The same scenario in `model` (module doc): a Jeffcott rotor becomes the cross-coupled
+    /// rotor with zero cross terms; a cross-coupled rotor's cross terms are dropped in the
+    /// Jeffcott model (they are reported as the truth no longer).
+    pub fn with_model(mut self, model: ModelKind) -> Self {
+        self.model = model;
+        self
+    }
+
     /// The complete scenario a simulation needs; `ov` (command-line values) take
     /// precedence.
     pub fn simulation(&self, ov: &SimulationOverrides) -> Result<Scenario, ScenarioFileError> {
         let o = &self.origin;
         let mut sc = match &self.builtin {
-            Some(s) => *s,
+            Some(s) => Scenario {
+                rotor: in_model(&s.rotor, self.model),
+                ..*s
+            },
             None => {
                 let rotor = self.rotor_for_simulation()?;
                 let speed = match self.speed {
@@ -329,14 +386,8 @@ impl ScenarioSpec {
     /// t = 0. The speed profile is in [`Self::identification`].
     pub fn knowledge(&self) -> Result<crate::pipeline::Knowledge, ScenarioFileError> {
         let v = self.identification()?;
+        let values = v.truth;
         let t = &v.truth;
-        let values = crate::pipeline::RotorValues {
-            m: t.m,
-            cx: t.cx,
-            kx: t.kx,
-            cz: t.cz,
-            kz: t.kz,
-        };
         // any grid will do: only the initial state is wanted
         let grid = SimulationOverrides {
             dt: Some(1.0),
@@ -345,6 +396,7 @@ impl ScenarioSpec {
         };
         let initial = self.simulation(&grid).ok().map(|s| s.initial);
         Ok(crate::pipeline::Knowledge {
+            model: self.model,
             a: v.a,
             unbalance: Unbalance {
                 m_u: v.m_u,
@@ -359,13 +411,15 @@ impl ScenarioSpec {
     /// What `identify` needs: known a, m_u, d, alpha; optional truth, speed, sampling.
     pub fn identification(&self) -> Result<IdentificationScenario, ScenarioFileError> {
         if let Some(s) = &self.builtin {
-            let u = s.rotor.unbalance();
+            let rotor = in_model(&s.rotor, self.model);
+            let u = rotor.unbalance();
             return Ok(IdentificationScenario {
-                a: s.rotor.a(),
+                model: self.model,
+                a: rotor.a(),
                 m_u: u.m_u,
                 d: u.d,
                 alpha: u.alpha,
-                truth: Truth::from_rotor(&s.rotor),
+                truth: Truth::of(&rotor.params()),
                 speed: Some(s.speed),
                 sampling: Some(s.sampling),
             });
@@ -380,7 +434,14 @@ impl ScenarioSpec {
             },
             None => None,
         };
+        // a Jeffcott rotor's cross terms are 0 (stated, in the cross-coupled model)
+        let cross = |k: &str| match (self.model, self.written_model) {
+            (ModelKind::Jeffcott, _) => None,
+            (ModelKind::CrossCoupled, ModelKind::Jeffcott) => Some(0.0),
+            (ModelKind::CrossCoupled, ModelKind::CrossCoupled) => opt(k),
+        };
         Ok(IdentificationScenario {
+            model: self.model,
             a,
             m_u,
             d,
@@ -391,22 +452,31 @@ impl ScenarioSpec {
                 cz: opt("cz"),
                 kx: opt("kx"),
                 kz: opt("kz"),
+                cxz: cross("cxz"),
+                czx: cross("czx"),
+                kxz: cross("kxz"),
+                kzx: cross("kzx"),
             },
             speed: self.speed,
             sampling,
         })
     }
 
+    /// The value kept as `key` (a canonical name, [`CANONICAL`]); missing, an error
+    /// naming the key as the file's model writes it.
     fn require_rotor(&self, key: &'static str, who: &str) -> Result<f64, ScenarioFileError> {
         match self.rotor.get(key) {
             Some(n) => Ok(n.value),
-            None => Err(ScenarioFileError::MissingRotorKey {
-                origin: self.origin.clone(),
-                key: key.to_owned(),
-                unit: unit_of(&ROTOR_KEYS, key).to_owned(),
-                section_line: self.rotor.line,
-                needed_by: Some(who.to_owned()),
-            }),
+            None => {
+                let written = written_key(self.written_model, key);
+                Err(ScenarioFileError::MissingRotorKey {
+                    origin: self.origin.clone(),
+                    key: written.to_owned(),
+                    unit: unit_of(rotor_keys(self.written_model), written).to_owned(),
+                    section_line: self.rotor.line,
+                    needed_by: Some(who.to_owned()),
+                })
+            }
         }
     }
 
@@ -426,23 +496,18 @@ impl ScenarioSpec {
     }
 
     fn rotor_for(&self, who: &str) -> Result<Rotor, ScenarioFileError> {
-        let mut v = [0.0; 9];
-        for (i, (k, _)) in ROTOR_KEYS.iter().enumerate() {
-            v[i] = self.require_rotor(k, who)?;
+        let mut v = RotorArray::default();
+        for (i, k) in CANONICAL_ORDER.iter().enumerate() {
+            let cross = i >= 9;
+            v.0[i] = if cross && self.written_model == ModelKind::Jeffcott {
+                0.0
+            } else {
+                self.require_rotor(k, who)?
+            };
         }
         // Values were range-checked when parsed; this cannot fail, but keep the mapping.
-        Rotor::new(rotor_params(&v)).map_err(|e| self.rotor_error(e))
-    }
-
-    fn rotor_error(&self, e: ModelError) -> ScenarioFileError {
-        let line = match &e {
-            ModelError::OutOfRange { field, .. } => {
-                let key = rotor_key(field);
-                self.rotor.get(key).and_then(|n| n.line)
-            }
-            ModelError::Inconsistent(_) => self.rotor.line,
-        };
-        ScenarioFileError::from_model(&self.origin, line, e, &ROTOR_KEY_NAMES)
+        Rotor::new(v.params(self.model))
+            .map_err(|e| rotor_error(&self.origin, &self.rotor, self.written_model, e))
     }
 
     fn sampling_with(&self, ov: &SimulationOverrides) -> Result<Sampling, ScenarioFileError> {
@@ -463,7 +528,7 @@ impl ScenarioSpec {
             let line = match &e {
                 ModelError::OutOfRange { field: "dt", .. } => dt.line,
                 ModelError::OutOfRange { .. } => duration.line,
-                ModelError::Inconsistent(_) => sec.line,
+                _ => sec.line,
             };
             let dt_key = if ov.dt.is_some() {
                 "--dt"
@@ -499,45 +564,111 @@ const INITIAL_FLAGS: &[(&str, &str)] = &[
     ("vz0", "--initial-vz"),
 ];
 
-fn rotor_key(model_field: &str) -> &'static str {
-    match model_field {
-        "alpha" => "alpha_deg",
-        f => ROTOR_KEYS
-            .iter()
-            .map(|(k, _)| *k)
-            .find(|k| *k == f)
-            .unwrap_or("?"),
+/// A model error about `[rotor]` (values kept under canonical names, written in
+/// `written`) as a scenario error naming the key and its line.
+fn rotor_error(
+    origin: &str,
+    rotor: &Section,
+    written: ModelKind,
+    e: ModelError,
+) -> ScenarioFileError {
+    // the model names its fields after the model (cxx when coupled); the file after its own
+    let key = |field: &str| {
+        let c = if field == "alpha" {
+            "alpha_deg"
+        } else {
+            canonical_static(field)
+        };
+        written_key(written, c)
+    };
+    match e {
+        ModelError::OutOfRange { field, .. } => {
+            let line = rotor.get(canonical_static(field)).and_then(|n| n.line);
+            let name = format!("rotor.{}", key(field));
+            ScenarioFileError::from_model(origin, line, e, &[(field, name.as_str())])
+        }
+        ModelError::Inconsistent(_) => ScenarioFileError::from_model(origin, rotor.line, e, &[]),
+        ModelError::DampingNotDissipative { cxx, cxz, czx, czz } => {
+            ScenarioFileError::DampingNotDissipative {
+                origin: origin.to_owned(),
+                line: rotor.line,
+                cxx,
+                cxz,
+                czx,
+                czz,
+            }
+        }
     }
 }
 
-/// The model's rotor field names and the TOML keys they are written as.
-const ROTOR_KEY_NAMES: [(&str, &str); 9] = [
-    ("m", "rotor.m"),
-    ("cx", "rotor.cx"),
-    ("cz", "rotor.cz"),
-    ("kx", "rotor.kx"),
-    ("kz", "rotor.kz"),
-    ("a", "rotor.a"),
-    ("m_u", "rotor.m_u"),
-    ("d", "rotor.d"),
-    ("alpha", "rotor.alpha_deg"),
+/// The canonical name of a model field (`cxx` -> `cx`, `alpha` -> `alpha_deg`).
+fn canonical_static(field: &str) -> &'static str {
+    if field == "alpha" {
+        return "alpha_deg";
+    }
+    CANONICAL_ORDER
+        .iter()
+        .chain(CANONICAL.iter().map(|(k, _)| k))
+        .find(|k| **k == field)
+        .map_or("?", |k| canonical(k))
+}
+
+/// The canonical names of every `[rotor]` value, in the order of [`RotorArray`].
+const CANONICAL_ORDER: [&str; 13] = [
+    "m",
+    "cx",
+    "cz",
+    "kx",
+    "kz",
+    "a",
+    "m_u",
+    "d",
+    "alpha_deg",
+    "cxz",
+    "czx",
+    "kxz",
+    "kzx",
 ];
 
-/// RotorParams from the nine values in `ROTOR_KEYS` order (alpha in degrees).
-fn rotor_params(v: &[f64; 9]) -> RotorParams {
-    RotorParams {
-        m: v[0],
-        cx: v[1],
-        cz: v[2],
-        kx: v[3],
-        kz: v[4],
-        a: v[5],
-        unbalance: Unbalance {
-            m_u: v[6],
-            d: v[7],
-            alpha: v[8].to_radians(),
-        },
+/// Every `[rotor]` value in [`CANONICAL_ORDER`] (alpha in degrees).
+#[derive(Debug, Clone, Copy, Default)]
+struct RotorArray([f64; 13]);
+
+impl RotorArray {
+    /// The rotor parameters in `model` (the cross terms dropped for a Jeffcott rotor).
+    fn params(&self, model: ModelKind) -> RotorParams {
+        let v = &self.0;
+        RotorParams {
+            m: v[0],
+            cx: v[1],
+            cz: v[2],
+            kx: v[3],
+            kz: v[4],
+            a: v[5],
+            unbalance: Unbalance {
+                m_u: v[6],
+                d: v[7],
+                alpha: v[8].to_radians(),
+            },
+            coupling: (model == ModelKind::CrossCoupled).then_some(CrossCoupling {
+                cxz: v[9],
+                czx: v[10],
+                kxz: v[11],
+                kzx: v[12],
+            }),
+        }
     }
+}
+
+/// `rotor` in `model`: a Jeffcott rotor gains zero cross terms, a cross-coupled one loses
+/// its cross terms.
+fn in_model(rotor: &Rotor, model: ModelKind) -> Rotor {
+    let mut p = rotor.params();
+    p.coupling = match model {
+        ModelKind::Jeffcott => None,
+        ModelKind::CrossCoupled => Some(p.cross()),
+    };
+    Rotor::new(p).unwrap_or(*rotor)
 }
 
 fn unit_of(keys: &[(&'static str, &'static str)], key: &str) -> &'static str {
@@ -938,6 +1069,126 @@ initial = { x = 1e-6 }
             e.to_string(),
             "rig.toml: missing section [rotor] (a, m_u, d, alpha_deg and, to simulate, m, cx, \
              cz, kx, kz)"
+        );
+    }
+
+    const CROSS: &str = r#"
+[rotor]
+model = "cross_coupled"
+m = 14.29
+a = 2.871
+kxx = 1.195e6
+kxz = -3.0e4
+kzx = 3.0e4
+kzz = 1.4e6
+cxx = 200.0
+cxz = 20.0
+czx = -5.0
+czz = 200.0
+m_u = 1.0e-4
+d = 0.15
+alpha_deg = 45.0
+[speed]
+kind = "constant"
+rpm = 1200.0
+[sampling]
+dt = 1.0e-4
+duration = 1.0
+"#;
+
+    #[test]
+    fn a_cross_coupled_rotor_reads_with_its_own_keys() {
+        let spec = ScenarioSpec::parse("c.toml", CROSS).unwrap();
+        assert_eq!(spec.model(), ModelKind::CrossCoupled);
+        let sc = spec.simulation(&SimulationOverrides::default()).unwrap();
+        let p = sc.rotor.params();
+        let c = p.coupling.expect("cross-coupled");
+        assert_eq!((p.kx, p.kz, p.cx, p.cz), (1.195e6, 1.4e6, 200.0, 200.0));
+        assert_eq!((c.kxz, c.kzx, c.cxz, c.czx), (-3.0e4, 3.0e4, 20.0, -5.0));
+        let id = spec.identification().unwrap();
+        assert_eq!(id.model, ModelKind::CrossCoupled);
+        assert_eq!((id.truth.kxz, id.truth.czx), (Some(-3.0e4), Some(-5.0)));
+        let k = spec.knowledge().unwrap();
+        assert_eq!(k.model, ModelKind::CrossCoupled);
+        // --model jeffcott: the same rotor without its cross terms
+        let j = spec.clone().with_model(ModelKind::Jeffcott);
+        let sj = j.simulation(&SimulationOverrides::default()).unwrap();
+        assert_eq!(sj.rotor.params().coupling, None);
+        assert_eq!(j.identification().unwrap().truth.kxz, None);
+        // a Jeffcott file in the cross-coupled model: zero cross terms, stated as such
+        let t = table1().with_model(ModelKind::CrossCoupled);
+        let st = t.simulation(&SimulationOverrides::default()).unwrap();
+        assert_eq!(st.rotor.params().coupling, Some(CrossCoupling::default()));
+        let file = ScenarioSpec::parse("s.toml", TABLE1)
+            .unwrap()
+            .with_model(ModelKind::CrossCoupled);
+        let truth = file.identification().unwrap().truth;
+        assert_eq!((truth.kx, truth.kzx), (Some(1.195e6), Some(0.0)));
+        assert_eq!(
+            file.simulation(&SimulationOverrides::default())
+                .unwrap()
+                .rotor
+                .params()
+                .coupling,
+            Some(CrossCoupling::default())
+        );
+    }
+
+    #[test]
+    fn cross_coupled_errors_name_the_key_the_value_and_the_range() {
+        let e = |text: &str| ScenarioSpec::parse("c.toml", text).unwrap_err().to_string();
+        // the symmetric part of [[200, 20], [-5, 200]] is fine; make it indefinite
+        let msg = e(&CROSS.replace("czx = -5.0", "czx = 500.0"));
+        assert!(
+            msg.starts_with("c.toml:2: rotor: the damping matrix [[cxx, cxz], [czx, czz]] = [[200, 20], [500, 200]] N s/m is not dissipative"),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("kzz = 1.4e6", "kzz = -1.4e6"));
+        assert!(
+            msg.starts_with(
+                "c.toml:9: rotor.kzz = -1400000 is out of range: must be finite and > 0 (N/m)"
+            ),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("cxx = 200.0", "cxx = -1.0"));
+        assert!(
+            msg.starts_with("c.toml:10: rotor.cxx = -1 is out of range"),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("kxz = -3.0e4", "kxz = nan"));
+        assert!(
+            msg.starts_with("c.toml:7: rotor.kxz = NaN is out of range: must be finite (N/m)"),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("kxx = 1.195e6", "kx = 1.195e6"));
+        assert!(
+            msg.starts_with("c.toml:6: unknown key rotor.kx; allowed keys in [rotor]: m, a, kxx")
+                && msg.ends_with("(kx is a key of rotor.model = \"jeffcott\")"),
+            "{msg}"
+        );
+        let msg = e(&TABLE1.replace("kx = 1.195e6", "kxz = 1.0"));
+        assert!(
+            msg.ends_with("(kxz is a key of rotor.model = \"cross_coupled\")"),
+            "{msg}"
+        );
+        let msg = e(&CROSS.replace("\"cross_coupled\"", "\"fluid_film\""));
+        assert_eq!(
+            msg,
+            "c.toml:3: rotor.model = \"fluid_film\" is not a rotor model: must be \"jeffcott\" or \"cross_coupled\""
+        );
+        let msg = e(&CROSS.replace("\"cross_coupled\"", "2"));
+        assert!(
+            msg.starts_with("c.toml:3: rotor.model = 2 has the wrong type"),
+            "{msg}"
+        );
+        let spec = ScenarioSpec::parse("c.toml", &CROSS.replace("kzx = 3.0e4\n", "")).unwrap();
+        let msg = spec
+            .simulation(&SimulationOverrides::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.starts_with("c.toml: missing key rotor.kzx (N/m)"),
+            "{msg}"
         );
     }
 }

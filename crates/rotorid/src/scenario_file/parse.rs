@@ -14,10 +14,11 @@ use std::ops::Range;
 use toml_edit::{ImDocument, Item, Key, Value};
 
 use super::{
-    rotor_key, rotor_params, unit_of, Num, ScenarioFileError, ScenarioSpec, Section, SpeedKind,
-    INITIAL_KEYS, ROTOR_CONTENTS, ROTOR_KEYS, ROTOR_KEY_NAMES, SAMPLING_KEYS, SECTIONS, SPEED_KEYS,
+    rotor_error, rotor_keys, unit_of, Num, RotorArray, ScenarioFileError, ScenarioSpec, Section,
+    SpeedKind, CANONICAL_ORDER, INITIAL_KEYS, ROTOR_CONTENTS, SAMPLING_KEYS, SECTIONS, SPEED_KEYS,
 };
 use crate::model::ModelError;
+use crate::parameter::ModelKind;
 use crate::{Rotor, Sampling, SpeedProfile};
 
 /// Parses one scenario file's text; `origin` (the file name) prefixes every message.
@@ -131,12 +132,16 @@ impl Parser<'_> {
             };
             raw.insert(sec, (line, entries));
         }
+        let model = match raw.get_mut("rotor") {
+            Some((_, entries)) => self.rotor_model(entries)?,
+            None => ModelKind::Jeffcott,
+        };
         let mut take = |name: &'static str, keys: &[(&'static str, &'static str)]| {
             raw.remove(name)
                 .map(|(line, entries)| self.section(name, line, keys, entries))
                 .transpose()
         };
-        let rotor = take("rotor", &ROTOR_KEYS)?.map(|(s, _)| s);
+        let rotor = take("rotor", rotor_keys(model))?.map(|(s, _)| s.canonical());
         let speed = take("speed", &SPEED_KEYS[1..])?;
         let sampling = take("sampling", &SAMPLING_KEYS)?.map(|(s, _)| s);
         let initial = take("initial", &INITIAL_KEYS)?.map(|(s, _)| s);
@@ -148,7 +153,7 @@ impl Parser<'_> {
                 needed_by: None,
             });
         };
-        self.check_rotor(&rotor)?;
+        self.check_rotor(&rotor, model)?;
         let speed = match speed {
             Some((s, kind)) => Some(self.speed_profile(&s, kind)?),
             None => None,
@@ -159,12 +164,42 @@ impl Parser<'_> {
         Ok(ScenarioSpec {
             origin: self.origin(),
             builtin: None,
+            model,
+            written_model: model,
             rotor,
             speed,
             sampling,
             initial: initial.unwrap_or_default(),
             acquisition,
         })
+    }
+
+    /// `rotor.model` (the string "jeffcott" or "cross_coupled"; default Jeffcott), taken out
+    /// of the section's entries.
+    fn rotor_model(&self, entries: &mut Vec<Entry<'_>>) -> Result<ModelKind, ScenarioFileError> {
+        let Some(i) = entries.iter().position(|e| e.key == "model") else {
+            return Ok(ModelKind::Jeffcott);
+        };
+        let Entry {
+            line,
+            value,
+            written,
+            ..
+        } = entries.remove(i);
+        match value {
+            Raw::String(s) => s.parse().map_err(|_| ScenarioFileError::UnknownModel {
+                origin: self.origin(),
+                line,
+                value: s,
+            }),
+            Raw::Number(_) | Raw::Other => Err(ScenarioFileError::WrongType {
+                origin: self.origin(),
+                line,
+                key: "rotor.model".to_owned(),
+                value: written,
+                expected: "the string \"jeffcott\" or \"cross_coupled\"".to_owned(),
+            }),
+        }
     }
 
     /// Check the keys of one section: known names, numbers only; `speed.kind` (a string)
@@ -194,17 +229,26 @@ impl Parser<'_> {
             }
             let Some((kname, unit)) = keys.iter().find(|(kk, _)| *kk == key) else {
                 let names = keys.iter().map(|(k, _)| *k);
-                let allowed: Vec<&str> = if name == "speed" {
-                    std::iter::once("kind").chain(names).collect()
-                } else {
-                    names.collect()
+                let allowed: Vec<&str> = match name {
+                    "speed" => std::iter::once("kind").chain(names).collect(),
+                    "rotor" => names.chain(std::iter::once("model")).collect(),
+                    _ => names.collect(),
                 };
+                let hint = (name == "rotor")
+                    .then(|| {
+                        ModelKind::ALL.into_iter().find(|m| {
+                            rotor_keys(*m) != keys && rotor_keys(*m).iter().any(|(k, _)| *k == key)
+                        })
+                    })
+                    .flatten()
+                    .map(|m| format!("{key} is a key of rotor.model = \"{}\"", m.name()));
                 return Err(ScenarioFileError::UnknownKey {
                     origin: self.origin(),
                     line,
                     section: name.to_owned(),
                     key: key.to_owned(),
                     allowed: allowed.join(", "),
+                    hint,
                 });
             };
             let Raw::Number(value) = value else {
@@ -257,7 +301,7 @@ impl Parser<'_> {
         }
     }
 
-    fn check_rotor(&self, rotor: &Section) -> Result<(), ScenarioFileError> {
+    fn check_rotor(&self, rotor: &Section, model: ModelKind) -> Result<(), ScenarioFileError> {
         // alpha is converted from degrees: check it in the user's unit first.
         if let Some(n) = rotor.get("alpha_deg") {
             if !n.value.is_finite() {
@@ -265,22 +309,15 @@ impl Parser<'_> {
             }
         }
         // Range-check the keys present with the model's own rules: missing keys take a
-        // valid placeholder, so any error comes from a key the user wrote.
-        let mut v = rotor_params_from_table1();
-        for (i, (k, _)) in ROTOR_KEYS.iter().enumerate() {
+        // valid placeholder (table1, no cross-coupling), so any error comes from a key the
+        // user wrote.
+        let mut v = rotor_values_of_table1();
+        for (i, k) in CANONICAL_ORDER.iter().enumerate() {
             if let Some(n) = rotor.get(k) {
-                v[i] = n.value;
+                v.0[i] = n.value;
             }
         }
-        Rotor::new(rotor_params(&v)).map_err(|e| {
-            let line = match &e {
-                ModelError::OutOfRange { field, .. } => {
-                    rotor.get(rotor_key(field)).and_then(|n| n.line)
-                }
-                ModelError::Inconsistent(_) => rotor.line,
-            };
-            ScenarioFileError::from_model(self.origin, line, e, &ROTOR_KEY_NAMES)
-        })?;
+        Rotor::new(v.params(model)).map_err(|e| rotor_error(self.origin, rotor, model, e))?;
         Ok(())
     }
 
@@ -345,7 +382,7 @@ impl Parser<'_> {
                     let key = if *field == "phi0" { "phi0_deg" } else { field };
                     s.get(key).and_then(|n| n.line)
                 }
-                ModelError::Inconsistent(_) => s.line,
+                _ => s.line,
             };
             ScenarioFileError::from_model(self.origin, line, e, &names)
         })
@@ -375,10 +412,11 @@ impl Parser<'_> {
     }
 }
 
-fn rotor_params_from_table1() -> [f64; 9] {
+/// table1's values in [`CANONICAL_ORDER`], without cross-coupling.
+fn rotor_values_of_table1() -> RotorArray {
     let r = Rotor::table1();
     let u = r.unbalance();
-    [
+    RotorArray([
         r.m(),
         r.cx(),
         r.cz(),
@@ -388,5 +426,9 @@ fn rotor_params_from_table1() -> [f64; 9] {
         u.m_u,
         u.d,
         u.alpha.to_degrees(),
-    ]
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ])
 }

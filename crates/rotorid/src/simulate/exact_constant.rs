@@ -79,12 +79,14 @@ pub(crate) fn balanced_system(rotor: &Rotor, omega: f64) -> (Matrix6<f64>, [f64;
     let w0 = (rotor.kx() * rotor.kz()).sqrt().sqrt() / m.sqrt();
     let l = if f > 0.0 { f / (m * w0 * w0) } else { 1.0 };
     let d = [1.0 / l, 1.0 / l, 1.0 / (l * w0), 1.0 / (l * w0), 1.0, 1.0];
+    // cross-coupling (zero for a Jeffcott rotor, which leaves every entry bit for bit)
+    let c = rotor.cross();
     #[rustfmt::skip]
     let a6 = Matrix6::new(
         0.0,             0.0,             1.0,         0.0,         0.0, 0.0,
         0.0,             0.0,             0.0,         1.0,         0.0, 0.0,
-        -rotor.kx() / m, 0.0,             -rotor.cx() / m, rotor.a() * w / m, f / m, 0.0,
-        0.0,             -rotor.kz() / m, -rotor.a() * w / m, -rotor.cz() / m, 0.0, f / m,
+        -rotor.kx() / m, -c.kxz / m,      -rotor.cx() / m, (rotor.a() * w - c.cxz) / m, f / m, 0.0,
+        -c.kzx / m,      -rotor.kz() / m, -(rotor.a() * w + c.czx) / m, -rotor.cz() / m, 0.0, f / m,
         0.0,             0.0,             0.0,         0.0,         0.0, w,
         0.0,             0.0,             0.0,         0.0,         -w,  0.0,
     );

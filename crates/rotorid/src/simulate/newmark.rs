@@ -24,7 +24,10 @@
 //! det S = (m + dt/2 cx + dt^2/4 kx) (m + dt/2 cz + dt^2/4 kz) + (a dt/2)^2 w (w + dt/2 w') > 0
 //! ```
 //!
-//! (the last term can only be negative for |w| < dt/2 |w'|, where it is negligible).
+//! (the last term can only be negative for |w| < dt/2 |w'|, where it is negligible). Bearing
+//! cross-coupling adds -(dt/2 cxz + dt^2/4 kxz)(dt/2 czx + dt^2/4 kzx) and cross products
+//! with the gyroscopic terms, all of order dt^2 c or dt^4 k^2 against m^2: det S stays positive
+//! for any bearing a rotor can have at a sampling rate that resolves it.
 //! 1 / det S is recomputed only when (w, w') change, i.e. once per run at constant speed.
 //!
 //! The phase sin(phi + alpha), cos(phi + alpha) of the unbalance force comes from a
@@ -140,12 +143,21 @@ impl Integrator for Newmark {
         let (u, v, a) = (self.u, self.v, self.a);
         let vp = v + a * h1;
         let up = u + v * dt + a * h2;
-        // rhs = F - C vp - K up,  C = [[cx, -a w], [a w, cz]],  K = [[kx, -a w'], [0, kz]]
-        let r0 = f[0] - (r.cx() * vp[0] - aw * vp[1]) - (r.kx() * up[0] - awd * up[1]);
-        let r1 = f[1] - (aw * vp[0] + r.cz() * vp[1]) - r.kz() * up[1];
-        // S = M + dt/2 C + dt^2/4 K = [[p, -(g + h)], [g, q]], g = dt/2 a w, h = dt^2/4 a w'
+        // rhs = F - C vp - K up,  C = [[cx, cxz - a w], [czx + a w, cz]],
+        // K = [[kx, kxz - a w'], [kzx, kz]] (cross terms 0 for a Jeffcott rotor: then every
+        // sum below is bit for bit the one without them)
+        let c = r.cross();
+        let r0 = f[0]
+            - (r.cx() * vp[0] + (c.cxz - aw) * vp[1])
+            - (r.kx() * up[0] + (c.kxz - awd) * up[1]);
+        let r1 = f[1] - ((c.czx + aw) * vp[0] + r.cz() * vp[1]) - (c.kzx * up[0] + r.kz() * up[1]);
+        // S = M + dt/2 C + dt^2/4 K = [[p, s01], [g, q]]: s01 = -(gw + h) + dt/2 cxz + dt^2/4 kxz,
+        // g = gw + dt/2 czx + dt^2/4 kzx, gw = dt/2 a w, h = dt^2/4 a w'
         let (p, q) = self.s_diag;
-        let (g, s01) = (h1 * aw, -(h1 * aw + h2 * awd));
+        let (g, s01) = (
+            h1 * aw + (h1 * c.czx + h2 * c.kzx),
+            -(h1 * aw + h2 * awd) + (h1 * c.cxz + h2 * c.kxz),
+        );
         if (s1.omega, s1.omega_dot) != (self.inv_det.0, self.inv_det.1) {
             // det S = p q + g (g + h) > 0 (module doc)
             self.inv_det = (s1.omega, s1.omega_dot, 1.0 / (p * q - s01 * g));

@@ -127,6 +127,7 @@ impl DoPri8Reference {
 
         let (r, sp) = (*rotor, *speed);
         let (mud, alpha) = (r.unbalance().mud(), r.unbalance().alpha);
+        let c = r.cross();
         let system = System::new(
             4,
             move |f: &mut Vector, t: f64, y: &Vector, _: &mut NoArgs| {
@@ -135,10 +136,14 @@ impl DoPri8Reference {
                 let force = unbalance_force_from(mud, s.omega, s.omega_dot, sn, cs);
                 let (x, z, vx, vz) = (l * y[0], l * y[1], lv * y[2], lv * y[3]);
                 let (aw, awd) = (r.a() * s.omega, r.a() * s.omega_dot);
-                // m x'' = Fx - cx x' + a w z' + a w' z - kx x
-                let ax = (force[0] - r.cx() * vx + aw * vz + awd * z - r.kx() * x) / m;
-                // m z'' = Fz - cz z' - a w x' - kz z
-                let az = (force[1] - r.cz() * vz - aw * vx - r.kz() * z) / m;
+                // m x'' = Fx - cx x' - cxz z' + a w z' + a w' z - kx x - kxz z
+                let ax = (force[0] - r.cx() * vx - c.cxz * vz + aw * vz + awd * z
+                    - r.kx() * x
+                    - c.kxz * z)
+                    / m;
+                // m z'' = Fz - czx x' - cz z' - a w x' - kzx x - kz z
+                let az =
+                    (force[1] - c.czx * vx - r.cz() * vz - aw * vx - c.kzx * x - r.kz() * z) / m;
                 f[0] = w0 * y[2];
                 f[1] = w0 * y[3];
                 f[2] = ax / lv;

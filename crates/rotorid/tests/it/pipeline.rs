@@ -77,13 +77,14 @@ fn refine_from_the_same_start_equals_refine_called_directly() {
     let rec = model.record();
     let id = identify(&rec, &model.knowledge(), &Method::refine()).unwrap();
     let detail = id.refine.as_ref().unwrap();
-    let s = detail.start.values;
+    let s = &detail.start.values;
+    let v = |p: Parameter| s.get(p).unwrap();
     let start = rotorid::RotorParams {
-        m: s.m,
-        cx: s.cx,
-        kx: s.kx,
-        cz: s.cz,
-        kz: s.kz,
+        m: v(Parameter::M),
+        cx: v(Parameter::Cx),
+        kx: v(Parameter::Kx),
+        cz: v(Parameter::Cz),
+        kz: v(Parameter::Kz),
         ..model.truth()
     };
     let direct = refine(

@@ -48,7 +48,7 @@ fn no_excitation_exact_zeros() {
     assert_eq!(r.sigma_x, 0.0);
     assert_nothing_confident(&r, &["m", "cx", "kx", "cz", "kz"]);
     let not_id = r.warnings.iter().find_map(|w| match w {
-        Warning::NotIdentifiable { parameters } => Some(parameters.clone()),
+        Warning::NotIdentifiable { parameters, .. } => Some(parameters.clone()),
         _ => None,
     });
     assert_eq!(not_id.unwrap(), ["m", "cx", "kx", "cz", "kz"]);

@@ -57,6 +57,10 @@ fn bad_inputs_are_rejected_with_their_name_and_range() {
 
     let none = RefineOptions {
         unknowns: Unknowns {
+            cxz: false,
+            czx: false,
+            kxz: false,
+            kzx: false,
             m: false,
             cx: false,
             kx: false,

@@ -3,7 +3,10 @@
 
 use rotorid::identify::algebraic::Quadrature;
 use rotorid::identify::modulating::ModulatingConfig;
-use rotorid::pipeline::{AlgebraicSettings, Method, ModulatingSettings, RefineSettings};
+use rotorid::parameter::Parameter;
+use rotorid::pipeline::{
+    AlgebraicSettings, Method, ModelChoice, ModulatingSettings, RefineSettings,
+};
 use rotorid::refine::Unknowns;
 
 // The defaults shown in `--help`, each written once (a test keeps them equal to the
@@ -188,9 +191,19 @@ pub struct IdentifyArgs {
 /// against the method and its range by [`method_of`]).
 #[derive(Debug, Clone, clap::Args)]
 pub struct MethodOptions {
-    /// refine only: the quantities to estimate, comma-separated, from m, cx, kx, cz, kz, a,
-    /// unbalance (m_u d and alpha) [default: m,cx,kx,cz,kz]. The initial state is always
-    /// estimated; the others are known (from the scenario).
+    /// The rotor model: jeffcott (the paper's rotor: m, cx, kx, cz, kz), cross_coupled
+    /// (bearings with all eight coefficients: m, cxx, cxz, czx, czz, kxx, kxz, kzx, kzz),
+    /// or, refine only, auto (fit both, keep those whose residuals pass the adequacy test,
+    /// take the simplest by BIC; the summary's model_selection says why) [default: the
+    /// scenario's rotor.model, else jeffcott]. Overrides the scenario's model key.
+    #[arg(long, value_enum, value_name = "MODEL")]
+    pub model: Option<ModelName>,
+
+    /// refine only: the quantities to estimate, comma-separated, from the model's m, cx,
+    /// kx, cz, kz (Jeffcott) or m, cxx, cxz, czx, czz, kxx, kxz, kzx, kzz (cross-coupled),
+    /// and a, unbalance (m_u d and alpha) [default: m and the model's bearing
+    /// coefficients]. The initial state is always estimated; the others are known (from
+    /// the scenario).
     #[arg(long, value_enum, value_name = "NAMES", value_delimiter = ',')]
     pub unknowns: Option<Vec<UnknownName>>,
 
@@ -251,6 +264,28 @@ impl IdentifyMethod {
     }
 }
 
+/// `--model` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelName {
+    /// The paper's Jeffcott rotor: m, cx, kx, cz, kz.
+    Jeffcott,
+    /// The rotor on cross-coupled bearings: m, cxx, cxz, czx, czz, kxx, kxz, kzx, kzz.
+    #[value(name = "cross_coupled")]
+    CrossCoupled,
+    /// refine only: fit both, keep the adequate ones, take the simplest by BIC.
+    Auto,
+}
+
+impl ModelName {
+    fn choice(self) -> ModelChoice {
+        match self {
+            ModelName::Jeffcott => ModelChoice::Jeffcott,
+            ModelName::CrossCoupled => ModelChoice::CrossCoupled,
+            ModelName::Auto => ModelChoice::Auto,
+        }
+    }
+}
+
 /// `--unknowns` values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum UnknownName {
@@ -268,6 +303,46 @@ pub enum UnknownName {
     A,
     /// Unbalance m_u d [kg m] and its angle alpha [rad].
     Unbalance,
+    /// Cross-coupled model: direct damping in x [N s/m].
+    Cxx,
+    /// Cross-coupled model: damping force in x per velocity in z [N s/m].
+    Cxz,
+    /// Cross-coupled model: damping force in z per velocity in x [N s/m].
+    Czx,
+    /// Cross-coupled model: direct damping in z [N s/m].
+    Czz,
+    /// Cross-coupled model: direct stiffness in x [N/m].
+    Kxx,
+    /// Cross-coupled model: restoring force in x per displacement in z [N/m].
+    Kxz,
+    /// Cross-coupled model: restoring force in z per displacement in x [N/m].
+    Kzx,
+    /// Cross-coupled model: direct stiffness in z [N/m].
+    Kzz,
+}
+
+impl UnknownName {
+    /// The parameters it selects.
+    fn parameters(self) -> &'static [Parameter] {
+        use Parameter as P;
+        match self {
+            UnknownName::M => &[P::M],
+            UnknownName::Cx => &[P::Cx],
+            UnknownName::Kx => &[P::Kx],
+            UnknownName::Cz => &[P::Cz],
+            UnknownName::Kz => &[P::Kz],
+            UnknownName::A => &[P::A],
+            UnknownName::Unbalance => &[P::Mud, P::Alpha],
+            UnknownName::Cxx => &[P::Cxx],
+            UnknownName::Cxz => &[P::Cxz],
+            UnknownName::Czx => &[P::Czx],
+            UnknownName::Czz => &[P::Czz],
+            UnknownName::Kxx => &[P::Kxx],
+            UnknownName::Kxz => &[P::Kxz],
+            UnknownName::Kzx => &[P::Kzx],
+            UnknownName::Kzz => &[P::Kzz],
+        }
+    }
 }
 
 /// The method and its settings from `--every` (identify only) and the options (each option
@@ -300,8 +375,18 @@ pub fn method_of(
     )?;
     only("--window", args.window.is_some(), &[Modulating, Refine])?;
     only("--unknowns", args.unknowns.is_some(), &[Refine])?;
+    let model = args.model.map(ModelName::choice);
+    if model == Some(ModelChoice::Auto) && method != Refine {
+        anyhow::bail!(
+            "--model auto applies to --method refine only, not to --method {}: choose \
+             jeffcott or cross_coupled",
+            method.name()
+        );
+    }
+    let fixed = model.and_then(ModelChoice::fixed);
     let mut algebraic = AlgebraicSettings {
         quadrature: args.quadrature.unwrap_or_default(),
+        model: fixed,
         ..AlgebraicSettings::default()
     };
     if let Some(tol) = args.tol {
@@ -327,6 +412,7 @@ pub fn method_of(
     }
     let mut modulating = ModulatingSettings {
         config: ModulatingConfig::with_window(window_s),
+        model: fixed,
     };
     if let Some(r) = args.rcond_min {
         if !(ok(r) && r <= 1.0) {
@@ -339,6 +425,7 @@ pub fn method_of(
         Algebraic => Method::Algebraic(algebraic),
         Modulating => Method::Modulating(modulating),
         Refine => Method::Refine(RefineSettings {
+            model,
             unknowns: unknowns_of(args.unknowns.as_deref()),
             algebraic,
             modulating,
@@ -347,23 +434,12 @@ pub fn method_of(
     })
 }
 
-/// The unknowns `--unknowns` selects (default m, cx, kx, cz, kz); the initial state is
+/// The unknowns `--unknowns` selects (`None`: the model's default); the initial state is
 /// always estimated.
-fn unknowns_of(names: Option<&[UnknownName]>) -> Unknowns {
-    let Some(names) = names else {
-        return Unknowns::default();
-    };
-    let has = |n: UnknownName| names.contains(&n);
-    Unknowns {
-        m: has(UnknownName::M),
-        cx: has(UnknownName::Cx),
-        kx: has(UnknownName::Kx),
-        cz: has(UnknownName::Cz),
-        kz: has(UnknownName::Kz),
-        a: has(UnknownName::A),
-        unbalance: has(UnknownName::Unbalance),
-        initial_state: true,
-    }
+fn unknowns_of(names: Option<&[UnknownName]>) -> Option<Unknowns> {
+    let names = names?;
+    let ps: Vec<Parameter> = names.iter().flat_map(|n| n.parameters()).copied().collect();
+    Some(Unknowns::from_parameters(&ps, true))
 }
 
 #[cfg(test)]

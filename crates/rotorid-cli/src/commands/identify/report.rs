@@ -9,8 +9,8 @@ use rotorid::pipeline::{CrbAt, Identification, MethodName, Severity, StartSource
 
 use crate::io::number::format_sig;
 
-/// The `warning:` lines: a prominent one when refine says the record does not determine
-/// the unknowns, then one per diagnostic (`note:` for a note).
+/// The `warning:` and `note:` lines: a prominent warning when refine says the record does
+/// not determine the unknowns, then one line per diagnostic.
 pub(crate) fn warning_lines(r: &Identification) -> Vec<String> {
     let mut out = Vec::new();
     if !r.identifiable() {
@@ -180,11 +180,16 @@ fn refine(r: &Identification) -> String {
         }
         (StartSource::Nominal, _) => "the scenario's values".to_owned(),
         (StartSource::Given, _) => "the given values".to_owned(),
+        (StartSource::NestedModel, _) => "the Jeffcott fit, cross terms 0".to_owned(),
         _ => "modulating estimate".to_owned(),
+    };
+    let model = match r.model {
+        rotorid::parameter::ModelKind::Jeffcott => String::new(),
+        m => format!(", {m} model"),
     };
     let _ = writeln!(
         out,
-        "refined {} samples of {}, t = {} .. {} s by maximum likelihood (start: {start}):",
+        "refined {} samples of {}, t = {} .. {} s by maximum likelihood{model} (start: {start}):",
         r.record.samples,
         input(r),
         format_sig(r.record.t_first_s, 6),
