@@ -15,6 +15,7 @@ mod identify;
 mod modulating;
 mod paper;
 mod plot;
+mod raw_records;
 mod refine;
 mod safety;
 mod scenario;

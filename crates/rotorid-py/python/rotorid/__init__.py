@@ -248,7 +248,10 @@ def identify(
             (every estimate from a window between half and one period old; default: one
             identifier over the whole record).
         window: modulating and refine: window of the modulating identifier [s] (default 0.02).
-        time_tolerance: allowed deviation of a stamp from the uniform grid, relative to dt.
+        time_tolerance: allowed deviation of a stamp from the uniform grid fitted by least
+            squares over the stamps, relative to that dt; stamps whose values have few
+            decimals (printed to 6 decimals at 25.6 kHz) may besides be off by one unit of
+            their last decimal (at most dt/4): accepted, with a note (``notes``).
         input, scenario: the names written into the summary (``to_dict()``), as the CLI
             writes its input path and ``--scenario`` argument; default None.
 

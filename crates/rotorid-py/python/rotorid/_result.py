@@ -38,6 +38,8 @@ class Identification:
             parameter's unit], unit, truth and rel_error ((value - truth) / truth); NaN
             where not determined or not given.
         warnings: the diagnostics' messages, worst first (what the CLI prints as warnings).
+        notes: the messages of the diagnostics that are notes (the numbers stand; the CLI
+            prints them as notes), e.g. time stamps accepted as rounded.
         estimates: DataFrame t [s], m_x, c_x, k_x, m_z, c_z, k_z [kg, N s/m, N/m],
             rcond_x, rcond_z, window: algebraic: one row per sample, values NaN where a
             direction is ill-conditioned (the CLI leaves them empty), window the restart
@@ -84,7 +86,19 @@ class Identification:
 
     @property
     def warnings(self) -> list[str]:
-        return [d["message"] for d in self._summary["diagnostics"]]
+        return [
+            d["message"]
+            for d in self._summary["diagnostics"]
+            if d.get("severity", "warning") != "note"
+        ]
+
+    @property
+    def notes(self) -> list[str]:
+        return [
+            d["message"]
+            for d in self._summary["diagnostics"]
+            if d.get("severity", "warning") == "note"
+        ]
 
     @property
     def estimates(self) -> pd.DataFrame:

@@ -21,6 +21,8 @@ class Identification:
     @property
     def warnings(self) -> list[str]: ...
     @property
+    def notes(self) -> list[str]: ...
+    @property
     def estimates(self) -> pd.DataFrame:
         """t [s], m_x, c_x, k_x, m_z, c_z, k_z, rcond_x, rcond_z, window."""
     @property
