@@ -28,6 +28,10 @@ function build(id) {
 }
 
 function alertText(al) {
+  if (al.kind === 'model_inadequate') {
+    return 'MODEL ALERT windows ' + al.previous_window + ' and ' + al.window +
+      ': the model does not explain them, ' + R.ago(al.arrived_ms);
+  }
   const pct = (100 * al.relative_change).toFixed(2);
   return 'ALERT ' + al.parameter + ' ' + (al.relative_change >= 0 ? '+' : '') + pct + ' % (z = ' + al.z.toFixed(1) +
     ') at window ' + al.window + ', ' + R.ago(al.arrived_ms);

@@ -233,9 +233,20 @@ function eventsRender() {
     const newest = S.tile && S.tile.window !== null ? S.tile.window : 0;
     for (const a of S.alerts.slice().reverse().slice(0, 12)) {
       const tr = R.el('tr', a.window + 10 > newest ? 'recent' : '');
-      for (const v of [a.window, R.plain(a.t0_s), a.parameter + ' [' + a.unit + ']', R.fmt(a.baseline, a.baseline_std_error), R.fmt(a.value, a.std_error),
-        (a.relative_change >= 0 ? '+' : '') + (100 * a.relative_change).toFixed(2) + ' %', a.z.toFixed(1), R.ago(a.arrived_ms)]) {
-        tr.appendChild(R.el('td', null, v));
+      if (a.kind === 'model_inadequate') {
+        // two consecutive windows the model does not explain: no parameter, a message
+        tr.appendChild(R.el('td', null, a.window));
+        tr.appendChild(R.el('td', null, R.plain(a.t0_s)));
+        tr.appendChild(R.el('td', null, 'model'));
+        const msg = R.el('td', null, 'windows ' + a.previous_window + ' and ' + a.window + ' not explained by the model: ' + a.message);
+        msg.colSpan = 4;
+        tr.appendChild(msg);
+        tr.appendChild(R.el('td', null, R.ago(a.arrived_ms)));
+      } else {
+        for (const v of [a.window, R.plain(a.t0_s), a.parameter + ' [' + a.unit + ']', R.fmt(a.baseline, a.baseline_std_error), R.fmt(a.value, a.std_error),
+          (a.relative_change >= 0 ? '+' : '') + (100 * a.relative_change).toFixed(2) + ' %', a.z.toFixed(1), R.ago(a.arrived_ms)]) {
+          tr.appendChild(R.el('td', null, v));
+        }
       }
       table.appendChild(tr);
     }

@@ -133,7 +133,7 @@ fn problem(status: StatusCode, message: String) -> Response {
     r
 }
 
-/// An error of a handler (answered by [`problem`]).
+/// An error of a handler (answered by `problem`).
 #[derive(Debug)]
 pub struct Problem {
     status: StatusCode,

@@ -20,7 +20,7 @@ use std::collections::{BTreeMap, VecDeque};
 
 use bytes::Bytes;
 use rotorid_fleet::drift::DriftState;
-use rotorid_fleet::{AlertRecord, ErrorRecord};
+use rotorid_fleet::{AlertRecord, ErrorRecord, ModelAlert, MODEL_INADEQUATE};
 use serde::{Deserialize, Serialize};
 
 use crate::raw::{OneXPoint, Orbit};
@@ -135,10 +135,59 @@ pub struct Value {
 pub struct AlertView {
     /// When it was stored \[ms since 1970, UTC\].
     pub arrived_ms: i64,
-    /// The record (docs/fleet.md).
+    /// The record (docs/fleet.md), its fields as published.
     #[serde(flatten)]
-    pub record: AlertRecord,
+    pub record: Alert,
 }
+
+/// The two records published on `rotorid.alert.<ID>` (docs/fleet.md): a parameter's drift,
+/// or two consecutive windows the model does not explain (told apart by `kind`, which only
+/// the second has).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Alert {
+    /// A parameter moved from its baseline.
+    Drift(AlertRecord),
+    /// The model does not explain two consecutive windows.
+    Model(ModelAlert),
+}
+
+impl Alert {
+    /// The window that raised it.
+    pub fn window(&self) -> u64 {
+        match self {
+            Alert::Drift(r) => r.window,
+            Alert::Model(r) => r.window,
+        }
+    }
+
+    /// The machine it names.
+    fn machine(&self) -> &str {
+        match self {
+            Alert::Drift(r) => &r.machine,
+            Alert::Model(r) => &r.machine,
+        }
+    }
+
+    /// The record with its texts cut to what a page shows.
+    fn cut(self) -> Self {
+        match self {
+            Alert::Drift(mut r) => {
+                r.parameter = cut(&r.parameter, MAX_NAME_LEN);
+                r.unit = cut(&r.unit, MAX_NAME_LEN);
+                Alert::Drift(r)
+            }
+            Alert::Model(mut r) => {
+                r.kind = cut(&r.kind, MAX_NAME_LEN);
+                r.message = cut(&r.message, MAX_ALERT_MESSAGE_LEN);
+                Alert::Model(r)
+            }
+        }
+    }
+}
+
+/// The longest model alert message kept (bytes; longer ones are cut).
+const MAX_ALERT_MESSAGE_LEN: usize = 2048;
 
 /// An error record as served.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -329,7 +378,7 @@ impl Machine {
         };
         let newest = self.newest_window().unwrap_or(0);
         let recent = |w: u64| w.saturating_add(s.recent_windows) > newest;
-        let state = if self.alerts.iter().any(|a| recent(a.record.window)) {
+        let state = if self.alerts.iter().any(|a| recent(a.record.window())) {
             "alert"
         } else if self.errors.iter().any(|e| e.window.is_none_or(recent)) {
             "errors"
@@ -539,7 +588,7 @@ impl FleetState {
         Ok(())
     }
 
-    /// An alert (JSON `AlertRecord`) of machine `id`.
+    /// An alert (JSON `AlertRecord`, or `ModelAlert` when it has `kind`) of machine `id`.
     pub fn apply_alert(
         &mut self,
         id: &str,
@@ -547,19 +596,35 @@ impl FleetState {
         json: &[u8],
     ) -> Result<(), MessageError> {
         let subject = rotorid_fleet::alert_subject(id);
-        let mut r: AlertRecord = serde_json::from_slice(json).map_err(|e| MessageError::Json {
+        let json_error = |e: serde_json::Error| MessageError::Json {
             subject: subject.clone(),
             what: "alert",
             message: e.to_string(),
-        })?;
-        if r.machine != id {
+        };
+        let v: serde_json::Value = serde_json::from_slice(json).map_err(json_error)?;
+        let r = if v.get("kind").is_some() {
+            let m: ModelAlert = serde_json::from_value(v).map_err(json_error)?;
+            if m.kind != MODEL_INADEQUATE {
+                return Err(MessageError::Json {
+                    subject,
+                    what: "alert",
+                    message: format!(
+                        "kind {:?} is not one this dashboard knows (\"{MODEL_INADEQUATE}\")",
+                        cut(&m.kind, 80)
+                    ),
+                });
+            }
+            Alert::Model(m)
+        } else {
+            Alert::Drift(serde_json::from_value(v).map_err(json_error)?)
+        };
+        if r.machine() != id {
             return Err(MessageError::WrongMachine {
                 subject,
-                named: cut(&r.machine, 80),
+                named: cut(r.machine(), 80),
             });
         }
-        r.parameter = cut(&r.parameter, MAX_NAME_LEN);
-        r.unit = cut(&r.unit, MAX_NAME_LEN);
+        let r = r.cut();
         let m = self.machine(id)?;
         m.alerts_seen += 1;
         m.alerts.push_back(AlertView {
@@ -924,6 +989,32 @@ mod tests {
                 ("b".into(), "ok"),
             ]
         );
+        // a model alert (two windows the model does not explain) sets it too, and is served
+        // with its own fields
+        let model = serde_json::json!({"fleet_schema":1,"kind":"model_inadequate","machine":"b",
+            "window":1,"t0_s":1.0,"previous_window":0,"message":"MODEL INADEQUATE: x"});
+        s.apply_alert("b", 0, &serde_json::to_vec(&model).unwrap())
+            .unwrap();
+        let tile = s.tile("b", 1000).unwrap();
+        assert_eq!(tile.state, "alert");
+        let served = serde_json::to_value(tile.last_alert.unwrap()).unwrap();
+        assert_eq!(served["kind"], "model_inadequate");
+        assert_eq!(served["previous_window"], 0);
+        assert_eq!(served["message"], "MODEL INADEQUATE: x");
+        assert!(served.get("parameter").is_none());
+        // a drift alert is served with its fields, no kind
+        let drift = serde_json::to_value(s.tile("a", 1000).unwrap().last_alert.unwrap()).unwrap();
+        assert_eq!(drift["parameter"], "kx");
+        assert_eq!(drift["z"], 7.0);
+        assert!(drift.get("kind").is_none());
+        // an unknown kind is refused, naming it
+        let other = serde_json::json!({"fleet_schema":1,"kind":"rub","machine":"b",
+            "window":2,"t0_s":2.0,"previous_window":1,"message":""});
+        let e = s
+            .apply_alert("b", 0, &serde_json::to_vec(&other).unwrap())
+            .unwrap_err();
+        assert!(e.to_string().contains("\"rub\""), "{e}");
+        s.apply_result("b", 2, 0, &result("b", 11, &[])).unwrap();
         // an alert 10 windows back no longer sets the state
         s.apply_result("a", 3, 0, &result("a", 10, &[])).unwrap();
         assert_eq!(s.tile("a", 1000).unwrap().state, "ok");

@@ -264,7 +264,7 @@ pub fn read_vectors<R: Read>(
         let run = text_field(file, rec, line, base[0], "run")?;
         let speed_rpm = ranged(
             file,
-            &rec,
+            rec,
             line,
             base[1],
             "speed_rpm",
@@ -367,7 +367,7 @@ pub fn read_masses<R: Read>(file: &str, input: R) -> Result<Vec<MassRow>, CsvErr
         let plane = text_field(file, rec, line, cols[1], "plane")?;
         let mass_kg = ranged(
             file,
-            &rec,
+            rec,
             line,
             cols[2],
             "mass_kg",
@@ -377,7 +377,7 @@ pub fn read_masses<R: Read>(file: &str, input: R) -> Result<Vec<MassRow>, CsvErr
         let radius_m = if mass_kg > 0.0 {
             ranged(
                 file,
-                &rec,
+                rec,
                 line,
                 cols[3],
                 "radius_m",
@@ -387,7 +387,7 @@ pub fn read_masses<R: Read>(file: &str, input: R) -> Result<Vec<MassRow>, CsvErr
         } else {
             ranged(
                 file,
-                &rec,
+                rec,
                 line,
                 cols[3],
                 "radius_m",
@@ -397,7 +397,7 @@ pub fn read_masses<R: Read>(file: &str, input: R) -> Result<Vec<MassRow>, CsvErr
         };
         let angle_deg = ranged(
             file,
-            &rec,
+            rec,
             line,
             cols[4],
             "angle_deg",

@@ -106,14 +106,14 @@ pub fn change(old: &Identification, new: &Identification) -> (f64, Option<Parame
     } else {
         ChangeBasis::Relative
     };
-    let mut worst = (0.0, None);
+    let mut worst = (0.0_f64, None);
     for (in_se, relative, p) in moves {
         let c = match basis {
             ChangeBasis::StdErrors => in_se.unwrap_or(f64::NAN),
             ChangeBasis::Relative => relative,
         };
-        // a NaN change (an estimate at 0) counts as unsettled
-        if !(c <= worst.0) {
+        // a NaN change (an estimate at 0) counts as unsettled, and stays the worst
+        if !worst.0.is_nan() && (c.is_nan() || c > worst.0) {
             worst = (c, Some(p));
         }
     }

@@ -150,7 +150,7 @@ pub(crate) fn of_model(rec: &Record, start: &RotorParams) -> Result<Adequacy, Pi
 /// stays `None`) when a value is withheld already or the model response cannot be
 /// computed.
 pub(crate) fn judge(ident: &mut Identification, rec: &Record, k: &Knowledge) {
-    let Some(r) = ident.rotor else {
+    let Some(r) = ident.rotor.as_ref().map(|r| r.params()) else {
         return;
     };
     let value = |p: Parameter| ident.parameter(p).and_then(|v| v.value);
@@ -160,13 +160,13 @@ pub(crate) fn judge(ident: &mut Identification, rec: &Record, k: &Knowledge) {
         _ => (r.m, r.m),
     };
     let rotor = RotorParams {
-        m: r.m,
         cx: r.cx * r.m / mx,
         kx: r.kx * r.m / mx,
         cz: r.cz * r.m / mz,
         kz: r.kz * r.m / mz,
         a: k.a,
         unbalance: k.unbalance,
+        ..r
     };
     let Ok(a) = of_model(rec, &rotor) else {
         return;

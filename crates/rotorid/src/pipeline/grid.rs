@@ -631,7 +631,7 @@ mod tests {
             g.push(i, t).unwrap();
         }
         assert_eq!(g.resolution(), 1e-6);
-        g.push(4, 0.5001171234567891).unwrap();
+        g.push(4, 0.500_117_123_456_789).unwrap();
         assert_eq!(g.resolution(), 0.0);
     }
 

@@ -26,7 +26,7 @@ use crate::refine::{
 };
 
 use super::adequacy::Adequacy;
-use super::diagnostic::{Diagnostic, Direction, Directions, Finding};
+use super::diagnostic::{Diagnostic, Directions, Finding};
 use super::error::PipelineError;
 use super::identification::StartSource;
 use super::identification::{

@@ -27,8 +27,10 @@ pub const ALPHA_DEG: f64 = 45.0;
 /// 25.6 kHz, 1 s.
 pub const RATE_HZ: f64 = 25_600.0;
 pub const SAMPLES: usize = 25_600;
-/// Probes: angle [deg], sensitivity [V/m], gap voltage [V], runout 1X-3X (um, deg).
-pub const PROBES: [(f64, f64, f64, [(f64, f64); 3]); 2] = [
+/// A probe: angle [deg], sensitivity [V/m], gap voltage [V], runout 1X-3X (um, deg).
+pub type Probe = (f64, f64, f64, [(f64, f64); 3]);
+/// The two probes.
+pub const PROBES: [Probe; 2] = [
     (
         135.0,
         7874.0,
