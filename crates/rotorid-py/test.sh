@@ -47,7 +47,7 @@ echo "== installing the test requirements"
 "$py" -m pip install --quiet --disable-pip-version-check \
     "maturin==1.16.*" "pytest>=8,<10" "nbclient>=0.10,<0.12" "nbformat>=5.10,<6" \
     "ipykernel>=6.29,<8" "dask>=2024.1" "pandas>=2.0,<4" "numpy>=1.26,<3" \
-    "matplotlib>=3.8,<4" "mypy>=1.18,<3"
+    "matplotlib>=3.8,<4" "mypy>=1.18,<3" "scipy>=1.11,<2"
 
 # The dev profile here (MATURIN_PEP517_ARGS overrides): it reuses the dependencies that
 # `cargo test --workspace` compiled (optimised, see Cargo.toml) where a release build

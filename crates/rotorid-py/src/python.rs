@@ -659,6 +659,62 @@ impl PySession {
     }
 }
 
+/// Multi-plane balancing (`rotorid.balance`) or, with `plan`, trial planning
+/// (`rotorid.plan_trials`): `balance.json` as text, from the CSV texts of the vectors and
+/// the masses (crate::balance).
+#[pyfunction]
+#[pyo3(signature = (vectors, masses, current, *, vectors_name="vectors", masses_name="masses",
+    method="ls", speeds=None, planes=None, limits=Vec::new(), weights=Vec::new(),
+    radius=Vec::new(), default_radius=None, holes_equal=Vec::new(), holes_angles=Vec::new(),
+    mass_set=None, per_hole=1, phase=None, unit=None, plan=None))]
+#[allow(clippy::too_many_arguments)]
+fn balance(
+    py: Python<'_>,
+    vectors: String,
+    masses: String,
+    current: String,
+    vectors_name: &str,
+    masses_name: &str,
+    method: &str,
+    speeds: Option<Vec<f64>>,
+    planes: Option<Vec<String>>,
+    limits: Vec<(String, f64)>,
+    weights: Vec<(String, f64)>,
+    radius: Vec<(String, f64)>,
+    default_radius: Option<f64>,
+    holes_equal: Vec<(String, (usize, f64))>,
+    holes_angles: Vec<(String, Vec<f64>)>,
+    mass_set: Option<Vec<f64>>,
+    per_hole: usize,
+    phase: Option<String>,
+    unit: Option<String>,
+    plan: Option<f64>,
+) -> PyResult<String> {
+    let r = crate::balance::Request {
+        vectors: (vectors_name.to_owned(), vectors),
+        masses: (masses_name.to_owned(), masses),
+        current,
+        method: method.to_owned(),
+        speeds,
+        planes,
+        limits,
+        weights,
+        radius,
+        default_radius,
+        holes_equal,
+        holes_angles,
+        mass_set,
+        per_hole,
+        phase,
+        unit,
+    };
+    py.detach(|| match plan {
+        Some(fraction) => crate::balance::plan_json(&r, fraction),
+        None => crate::balance::balance_json(&r),
+    })
+    .map_err(py_err)
+}
+
 /// The extension module.
 #[pymodule]
 #[pyo3(name = "_rotorid")]
@@ -670,6 +726,7 @@ fn rotorid_extension(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_blocks, m)?)?;
     m.add_class::<PyBlocks>()?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;
+    m.add_function(wrap_pyfunction!(balance, m)?)?;
     m.add("METHODS", options::METHOD_NAMES.to_vec())?;
     m.add("UNKNOWNS", options::UNKNOWN_NAMES.to_vec())?;
     m.add("MODELS", options::MODEL_NAMES.to_vec())?;

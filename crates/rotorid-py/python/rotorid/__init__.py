@@ -26,6 +26,12 @@ Quick start::
 
 Every computation runs in the Rust library with the GIL released; a record gives the
 same result (``res.to_dict()``) as ``rotorid identify --summary`` on the same file.
+
+Balancing (influence coefficients of many planes, sensors and speeds)::
+
+    b = rotorid.balance(vectors_df, masses_df, current="asfound", holes={"disk1": 12})
+    b.corrections                                      # mass_kg, angle_deg and their std
+    b.residual, b.influence, b.split                   # DataFrames; b.to_dict() == balance.json
 """
 
 from __future__ import annotations
@@ -38,6 +44,7 @@ import pandas as pd
 
 from . import _rotorid
 from ._rotorid import ESTIMATE_COLUMNS, METHODS, MODELS, UNKNOWNS, Scenario
+from ._balance import Balance, TrialPlan, balance, plan_trials
 from ._result import Identification
 
 __all__ = [
@@ -45,10 +52,14 @@ __all__ = [
     "METHODS",
     "MODELS",
     "UNKNOWNS",
+    "Balance",
     "Identification",
     "Scenario",
     "Session",
+    "TrialPlan",
+    "balance",
     "identify",
+    "plan_trials",
     "read",
     "read_blocks",
     "simulate",
@@ -254,7 +265,10 @@ def identify(
             (every estimate from a window between half and one period old; default: one
             identifier over the whole record).
         window: modulating and refine: window of the modulating identifier [s] (default 0.02).
-        time_tolerance: allowed deviation of a stamp from the uniform grid, relative to dt.
+        time_tolerance: allowed deviation of a stamp from the uniform grid fitted by least
+            squares over the stamps, relative to that dt; stamps whose values have few
+            decimals (printed to 6 decimals at 25.6 kHz) may besides be off by one unit of
+            their last decimal (at most dt/4): accepted, with a note (``notes``).
         input, scenario: the names written into the summary (``to_dict()``), as the CLI
             writes its input path and ``--scenario`` argument; default None.
 

@@ -6,6 +6,10 @@ from typing import Any, Iterator, Mapping, Sequence, final
 import numpy as np
 import pandas as pd
 
+from ._balance import Balance as Balance
+from ._balance import TrialPlan as TrialPlan
+from ._balance import balance as balance
+from ._balance import plan_trials as plan_trials
 from ._result import Identification as Identification
 
 __all__ = [
@@ -13,10 +17,14 @@ __all__ = [
     "METHODS",
     "MODELS",
     "UNKNOWNS",
+    "Balance",
     "Identification",
     "Scenario",
     "Session",
+    "TrialPlan",
+    "balance",
     "identify",
+    "plan_trials",
     "read",
     "read_blocks",
     "simulate",

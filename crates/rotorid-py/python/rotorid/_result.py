@@ -58,7 +58,8 @@ class Identification:
             as they stand.
         notes: the messages of the diagnostics of severity note (the CLI's ``note:``):
             worth knowing, the numbers stand (which model ``model="auto"`` took and why;
-            that cross-coupled bearings explain data a Jeffcott fit could not).
+            that cross-coupled bearings explain data a Jeffcott fit could not; time stamps
+            accepted as rounded).
         model_selection: how ``model="auto"`` chose the model (a DataFrame, one row per
             candidate), or None when the model was given.
         estimates: DataFrame t [s], m_x, c_x, k_x, m_z, c_z, k_z [kg, N s/m, N/m],

@@ -6,7 +6,7 @@ import numpy as np
 
 from . import Scenario as Scenario
 
-__all__ = ["ESTIMATE_COLUMNS", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "identify", "read", "read_blocks", "simulate"]
+__all__ = ["ESTIMATE_COLUMNS", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "read", "read_blocks", "simulate"]
 
 METHODS: list[str]
 MODELS: list[str]
@@ -56,6 +56,30 @@ def identify(
     scenario_name: str | None = None,
 ) -> tuple[str, dict[str, np.ndarray], float]:
     """(summary JSON, estimates columns, seconds spent in the library)."""
+
+def balance(
+    vectors: str,
+    masses: str,
+    current: str,
+    *,
+    vectors_name: str = "vectors",
+    masses_name: str = "masses",
+    method: str = "ls",
+    speeds: list[float] | None = None,
+    planes: list[str] | None = None,
+    limits: list[tuple[str, float]] = ...,
+    weights: list[tuple[str, float]] = ...,
+    radius: list[tuple[str, float]] = ...,
+    default_radius: float | None = None,
+    holes_equal: list[tuple[str, tuple[int, float]]] = ...,
+    holes_angles: list[tuple[str, list[float]]] = ...,
+    mass_set: list[float] | None = None,
+    per_hole: int = 1,
+    phase: str | None = None,
+    unit: str | None = None,
+    plan: float | None = None,
+) -> str:
+    """balance.json (or, with plan=fraction, the trial plan) as JSON text."""
 
 @final
 class Session:

@@ -411,6 +411,10 @@ pub struct RefineDetail {
     /// Condition number of the Fisher information scaled to unit diagonal (`None`:
     /// infinite).
     pub condition_number: Option<f64>,
+    /// Rank of the Fisher information: how many independent combinations of the unknowns
+    /// (initial state included) the record informs.
+    #[serde(default)]
+    pub fisher_rank: Option<u64>,
     /// The discrete model of the fit.
     pub discretisation: String,
     /// How the standard errors are computed.

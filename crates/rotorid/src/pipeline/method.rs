@@ -202,6 +202,9 @@ pub struct RefineSettings {
 }
 
 /// An identification method and its settings.
+// The refine variant carries the settings of both identifiers that may start it; a
+// Method is made once per identification, and boxing it would cost `Copy`.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Method {
     /// The paper's algebraic identifier: an estimate per sample, streaming.

@@ -49,7 +49,7 @@ pub fn crb(
     let (f, _) = sink.acc.combine(sigma_x * sigma_x, sigma_z * sigma_z);
     let fi = Fisher::new(&f, cols.n);
     let rs = rows(&t, &cols, &fi);
-    let identifiable = identifiability_warnings(&rs, fi.condition_number)
+    let identifiable = identifiability_warnings(&rs, fi.condition_number, Vec::new())
         .iter()
         .all(|w| matches!(w, super::result::Warning::PoorlyDetermined { .. }));
     let mut parameters = Vec::new();

@@ -126,6 +126,28 @@ impl Fisher {
         }
     }
 
+    /// The rank of the information: informed directions that are not null.
+    pub(crate) fn rank(&self) -> usize {
+        self.null.iter().filter(|&&n| !n).count()
+    }
+
+    /// The columns that take part in the least informed direction (the eigenvector of the
+    /// smallest eigenvalue of the scaled information, null or not): those whose squared
+    /// weight in it exceeds `share`, largest first. These are the unknowns the record
+    /// hardly tells apart.
+    pub(crate) fn weakest(&self, share: f64) -> Vec<usize> {
+        let m = self.informed.len();
+        let Some(k) = (0..m).min_by(|&a, &b| self.vals[a].total_cmp(&self.vals[b])) else {
+            return Vec::new();
+        };
+        let mut w: Vec<(usize, f64)> = (0..m)
+            .map(|a| (self.informed[a], self.vecs[(a, k)].powi(2)))
+            .filter(|&(_, v)| v > share)
+            .collect();
+        w.sort_by(|a, b| b.1.total_cmp(&a.1));
+        w.into_iter().map(|(i, _)| i).collect()
+    }
+
     /// Standard deviation sqrt(Cov_ii) (+inf when unidentifiable).
     pub(crate) fn std(&self, i: usize) -> f64 {
         self.cov[i * self.n + i].sqrt()
@@ -195,6 +217,21 @@ mod tests {
         // no step along the null direction (1, -1)
         let (d, _) = a.step(&[1.0, 1.0, 0.0], 0.0);
         assert!((d[0] - d[1]).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_weakest_direction_names_the_correlated_pair() {
+        // theta_0 and theta_1 nearly equal in effect (correlation 0.999999), theta_2 apart
+        let c = 0.999_999;
+        let f = [1.0, c, 0.0, c, 1.0, 0.0, 0.0, 0.0, 3.0];
+        let a = Fisher::new(&f, 3);
+        assert_eq!(a.rank(), 3);
+        let mut w = a.weakest(0.1);
+        w.sort();
+        assert_eq!(w, vec![0, 1]);
+        assert!((a.condition_number - (1.0 + c) / (1.0 - c)).abs() < 1e-3 * a.condition_number);
+        let sing = Fisher::new(&[1.0, 1.0, 1.0, 1.0], 2);
+        assert_eq!(sing.rank(), 1);
     }
 
     #[test]

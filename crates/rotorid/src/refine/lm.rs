@@ -46,7 +46,7 @@ use super::error::RefineError;
 use super::fisher::Fisher;
 use super::record::Record;
 use super::result::{
-    identifiability_warnings, rows, FittedValue, Refined, RobustCovariance, Warning,
+    identifiability_warnings, rows, weakest_names, FittedValue, Refined, RobustCovariance, Warning,
     STD_ERROR_BASIS,
 };
 use super::steady::{steady_initial_state, TRANSIENT_SIGNIFICANCE};
@@ -553,7 +553,8 @@ fn assemble(
             last_step: s.last_step,
         });
     }
-    let mut id_warnings = identifiability_warnings(&rs, fi.condition_number);
+    let mut id_warnings =
+        identifiability_warnings(&rs, fi.condition_number, weakest_names(fi, cols));
     if s.no_transient.is_some() {
         for w in &mut id_warnings {
             if let Warning::NotIdentifiable {
@@ -609,6 +610,7 @@ fn assemble(
         converged: s.converged,
         identifiable,
         condition_number: fi.condition_number,
+        fisher_rank: fi.rank(),
         warnings,
         discretisation: s.discretisation,
         std_error_basis: STD_ERROR_BASIS,

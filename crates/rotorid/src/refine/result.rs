@@ -81,6 +81,9 @@ pub enum Warning {
         condition_number: f64,
         /// The limit it exceeds ([`CONDITION_LIMIT`]).
         limit: f64,
+        /// The unknowns in the least informed direction (the near-null space), largest
+        /// share first.
+        parameters: Vec<&'static str>,
     },
     /// The standard error exceeds the value itself (or 1 rad for alpha; or, for a
     /// cross-coupled coefficient, its scale [`FittedValue::scale`]).
@@ -138,10 +141,21 @@ impl fmt::Display for Warning {
             Warning::IllConditioned {
                 condition_number,
                 limit,
-            } => write!(
-                f,
-                "the unknowns are nearly inseparable: Fisher information condition number {condition_number:.3e} > {limit:.0e}"
-            ),
+                parameters,
+            } => {
+                write!(
+                    f,
+                    "the unknowns are nearly inseparable: Fisher information condition number {condition_number:.3e} > {limit:.0e}"
+                )?;
+                if !parameters.is_empty() {
+                    write!(
+                        f,
+                        "; the record hardly tells apart {}",
+                        parameters.join(", ")
+                    )?;
+                }
+                Ok(())
+            }
             Warning::PoorlyDetermined {
                 parameter,
                 relative_std_error,
@@ -206,6 +220,9 @@ pub struct Refined {
     pub identifiable: bool,
     /// Condition number of the Fisher information scaled to unit diagonal.
     pub condition_number: f64,
+    /// Rank of the Fisher information: the directions of the unknowns the record informs
+    /// (the number of unknowns when all are identifiable).
+    pub fisher_rank: usize,
     /// Diagnostics, worst first.
     pub warnings: Vec<Warning>,
     /// The discrete model used.
@@ -345,6 +362,19 @@ fn relative(std: f64, value: f64) -> f64 {
     }
 }
 
+/// The names of the columns in the least informed direction of `fi` (the internal names:
+/// the unbalance as mud_cos_alpha, mud_sin_alpha).
+pub(crate) fn weakest_names(fi: &Fisher, cols: &Columns) -> Vec<&'static str> {
+    fi.weakest(WEAK_SHARE)
+        .into_iter()
+        .map(|j| cols.kinds()[j].name_in(cols.model))
+        .collect()
+}
+
+/// Squared weight in the least informed direction above which an unknown is named in an
+/// ill-conditioning warning (the weights of a unit vector sum to 1).
+const WEAK_SHARE: f64 = 0.1;
+
 /// The reported quantities at `t` with covariance from `fi` (column order `cols`).
 pub(crate) fn rows(t: &Theta, cols: &Columns, fi: &Fisher) -> Vec<Row> {
     let n = cols.n;
@@ -415,8 +445,13 @@ pub(crate) fn rows(t: &Theta, cols: &Columns, fi: &Fisher) -> Vec<Row> {
     out
 }
 
-/// Identifiability warnings for `rows` (NotIdentifiable, IllConditioned, PoorlyDetermined).
-pub(crate) fn identifiability_warnings(rows: &[Row], condition_number: f64) -> Vec<Warning> {
+/// Identifiability warnings for `rows` (NotIdentifiable, IllConditioned with the unknowns
+/// of the least informed direction `weakest`, PoorlyDetermined).
+pub(crate) fn identifiability_warnings(
+    rows: &[Row],
+    condition_number: f64,
+    weakest: Vec<&'static str>,
+) -> Vec<Warning> {
     let mut w = Vec::new();
     let unid: Vec<&'static str> = rows
         .iter()
@@ -434,6 +469,7 @@ pub(crate) fn identifiability_warnings(rows: &[Row], condition_number: f64) -> V
         w.push(Warning::IllConditioned {
             condition_number,
             limit: CONDITION_LIMIT,
+            parameters: weakest,
         });
     }
     for r in rows.iter().filter(|r| r.std.is_finite() && !r.initial) {
@@ -445,7 +481,7 @@ pub(crate) fn identifiability_warnings(rows: &[Row], condition_number: f64) -> V
                 });
             }
         } else if let Some(scale) = r.scale {
-            if !(r.std <= scale) {
+            if r.std > scale || scale.is_nan() {
                 w.push(Warning::PoorlyDetermined {
                     parameter: r.name,
                     relative_std_error: r.std / scale,

@@ -219,7 +219,7 @@ impl Parser<'_> {
                     section: path.to_owned(),
                     key: k.to_owned(),
                     allowed: allowed.join(", "),
-                    hint: None,
+                    other_model: None,
                 });
             }
             items.push((k, kl, v));

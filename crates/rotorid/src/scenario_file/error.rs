@@ -63,7 +63,7 @@ pub enum ScenarioFileError {
     #[error(
         "{}: unknown key {section}.{key}; allowed keys in [{section}]: {allowed}{}",
         At(origin, line),
-        hint.as_deref().map_or(String::new(), |h| format!(" ({h})"))
+        other_model.map_or(String::new(), |m| format!(" ({key} is a key of rotor.model = \"{}\")", m.name()))
     )]
     UnknownKey {
         /// The file name.
@@ -76,9 +76,9 @@ pub enum ScenarioFileError {
         key: String,
         /// The section's keys, comma-separated.
         allowed: String,
-        /// Where the key belongs, when it is another model's
-        /// (`kxx is a key of rotor.model = "cross_coupled"`).
-        hint: Option<String>,
+        /// The model whose key it is, when it is another model's rotor key
+        /// (the message then says `kxx is a key of rotor.model = "cross_coupled"`).
+        other_model: Option<crate::parameter::ModelKind>,
     },
     /// A value of the wrong TOML type (`rotor.m = "heavy"`).
     #[error(

@@ -234,21 +234,20 @@ impl Parser<'_> {
                     "rotor" => names.chain(std::iter::once("model")).collect(),
                     _ => names.collect(),
                 };
-                let hint = (name == "rotor")
+                let other_model = (name == "rotor")
                     .then(|| {
                         ModelKind::ALL.into_iter().find(|m| {
                             rotor_keys(*m) != keys && rotor_keys(*m).iter().any(|(k, _)| *k == key)
                         })
                     })
-                    .flatten()
-                    .map(|m| format!("{key} is a key of rotor.model = \"{}\"", m.name()));
+                    .flatten();
                 return Err(ScenarioFileError::UnknownKey {
                     origin: self.origin(),
                     line,
                     section: name.to_owned(),
                     key: key.to_owned(),
                     allowed: allowed.join(", "),
-                    hint,
+                    other_model,
                 });
             };
             let Raw::Number(value) = value else {

@@ -130,7 +130,7 @@ fn everything_unknown_is_reported_unidentifiable() {
     let r = refine(&rec, &start, &InitialState::default(), &opts).unwrap();
     assert!(!r.identifiable);
     match &r.warnings[..] {
-        [Warning::NotIdentifiable { parameters }, ..] => {
+        [Warning::NotIdentifiable { parameters, .. }, ..] => {
             assert_eq!(
                 parameters,
                 &["m", "cx", "kx", "cz", "kz", "a", "mud", "alpha"]
