@@ -16,14 +16,19 @@
 //! raised to 0 by the fit itself). Known quantities, a and the unbalance come from the
 //! [`Knowledge`].
 //!
-//! The cross-coupled model starts from the same estimates of m and the direct
-//! coefficients, with its cross-coupled coefficients at their nominal values or, when none
-//! is given, 0: the Jeffcott rotor nested in it (the refinement's continuation reaches
-//! cross-coupling of several per cent of the direct stiffness from there; docs/method.md
-//! section 5.6).
+//! The cross-coupled model starts from the cross-coupled modulating estimate over the
+//! whole record (`CrossModulatingIdentifier`: per row m and that row's four bearing
+//! coefficients) when both rows are well conditioned and the unknowns it gives are
+//! physical (m, kxx, kzz > 0, finite, and a rotor the model accepts); else from the
+//! Jeffcott start above with its cross-coupled coefficients at their nominal values or,
+//! when none is given, 0: the Jeffcott rotor nested in it (the refinement's continuation
+//! reaches cross-coupling of several per cent of the direct stiffness from there;
+//! docs/method.md section 5.6), the start's note saying why.
 
 use crate::identify::algebraic::AlgebraicIdentifier;
-use crate::identify::modulating::{ModulatingEstimate, ModulatingIdentifier};
+use crate::identify::modulating::{
+    CrossModulatingIdentifier, ModulatingEstimate, ModulatingIdentifier,
+};
 use crate::model::{CrossCoupling, RotorParams};
 use crate::parameter::{ModelKind, Parameter};
 use crate::refine::Unknowns;
@@ -94,10 +99,89 @@ pub(crate) fn find(
 ) -> Result<Found, PipelineError> {
     let mut found = find_jeffcott(rec, k, s, u)?;
     if model == ModelKind::CrossCoupled {
-        found.params = with_cross(&found.params, k, u);
-        found.start.values = RotorSummary::of(&found.params);
+        match cross_modulating_start(rec, k, s, u, &with_cross(&found.params, k, u)) {
+            Ok((t, params)) => {
+                found.params = params;
+                found.start = start(
+                    StartSource::Modulating,
+                    Some(t),
+                    &params,
+                    Some("the cross-coupled modulating estimate".to_owned()),
+                );
+            }
+            Err(why) => {
+                found.params = with_cross(&found.params, k, u);
+                found.start.values = RotorSummary::of(&found.params);
+                let note = format!(
+                    "cross-coupled modulating estimate unusable ({why}): the Jeffcott start \
+                     with the cross-coupled coefficients nominal or 0"
+                );
+                found.start.note = Some(match found.start.note.take() {
+                    Some(n) if !n.is_empty() => format!("{n}; {note}"),
+                    _ => note,
+                });
+            }
+        }
     }
     Ok(found)
+}
+
+/// The cross-coupled modulating estimate over the whole record as the start of the
+/// unknowns `u` (the rest as in `base`: known values, a and the unbalance), and the time
+/// of the estimate; `Err` says why it is not usable.
+fn cross_modulating_start(
+    rec: &Record,
+    k: &Knowledge,
+    s: &RefineSettings,
+    u: &Unknowns,
+    base: &RotorParams,
+) -> Result<(f64, RotorParams), String> {
+    let cfg = s.modulating.config;
+    let mut id = CrossModulatingIdentifier::new(k.identify_known(), rec.grid().dt, cfg)
+        .map_err(|e| e.to_string())?;
+    for i in 0..rec.len() {
+        id.push(&rec.measurement(i)).map_err(|e| e.to_string())?;
+    }
+    let est = id.finish().map_err(|e| e.to_string())?;
+    let ok = est.well_conditioned(cfg.rcond_min);
+    if !(ok[0] && ok[1]) {
+        return Err(format!(
+            "the {} row is not well conditioned",
+            if ok[0] { "z" } else { "x" }
+        ));
+    }
+    // x row: m_x, cxx, cxz, kxx, kxz; z row: m_z, czx, czz, kzx, kzz
+    let (x, z) = (est.x.values, est.z.values);
+    let pick = |q: Parameter, e: f64, current: f64| if u.selects(q) { e } else { current };
+    let c = base.cross();
+    let p = RotorParams {
+        m: pick(Parameter::M, 0.5 * (x[0] + z[0]), base.m),
+        cx: pick(Parameter::Cxx, x[1], base.cx),
+        kx: pick(Parameter::Kxx, x[3], base.kx),
+        cz: pick(Parameter::Czz, z[2], base.cz),
+        kz: pick(Parameter::Kzz, z[4], base.kz),
+        coupling: Some(CrossCoupling {
+            cxz: pick(Parameter::Cxz, x[2], c.cxz),
+            czx: pick(Parameter::Czx, z[1], c.czx),
+            kxz: pick(Parameter::Kxz, x[4], c.kxz),
+            kzx: pick(Parameter::Kzx, z[3], c.kzx),
+        }),
+        ..*base
+    };
+    let pc = p.cross();
+    let finite = [p.m, p.cx, p.kx, p.cz, p.kz, pc.cxz, pc.czx, pc.kxz, pc.kzx]
+        .iter()
+        .all(|v| v.is_finite());
+    if !finite || p.m <= 0.0 || p.kx <= 0.0 || p.kz <= 0.0 {
+        return Err(format!(
+            "m = {:.4e}, kxx = {:.4e}, kzz = {:.4e} are not all finite and positive",
+            p.m, p.kx, p.kz
+        ));
+    }
+    // negative direct damping or an indefinite damping matrix is left to the fit's own
+    // bounds; the start must be a rotor the model accepts
+    crate::model::Rotor::new(p).map_err(|e| e.to_string())?;
+    Ok((est.t, p))
 }
 
 /// `p` in the cross-coupled model: its cross-coupled coefficients at their nominal values

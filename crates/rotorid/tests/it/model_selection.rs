@@ -128,3 +128,60 @@ fn hundred_seed_selection_rates() {
         assert!(rate(&tm, ModelKind::Jeffcott, 100..200) >= 0.95);
     }
 }
+
+#[test]
+fn a_fixed_cross_coupled_fit_starts_from_the_cross_coupled_modulating_estimate() {
+    use rotorid::parameter::Parameter;
+    use rotorid::pipeline::StartSource;
+    let truth = rotorid::test_models::cross_coupled_rotor();
+    let tc = truth.cross();
+    for tm in [cross_coupled(), cross_coupled_ramp(600.0)] {
+        let id = run(&tm.with_noise(40.0, 21), ModelChoice::CrossCoupled);
+        assert_eq!(id.model, ModelKind::CrossCoupled);
+        let start = &id.refine.as_ref().unwrap().start;
+        assert_eq!(
+            start.source,
+            StartSource::Modulating,
+            "{}: {start:?}",
+            tm.name
+        );
+        assert!(
+            start
+                .note
+                .as_deref()
+                .unwrap_or("")
+                .contains("cross-coupled modulating"),
+            "{}: {start:?}",
+            tm.name
+        );
+        // the cross-coupled terms start near their values (the Jeffcott start had them 0)
+        let v = |p: Parameter| start.values.get(p).unwrap();
+        for (p, want) in [(Parameter::Kxz, tc.kxz), (Parameter::Kzx, tc.kzx)] {
+            assert!(
+                (v(p) / want - 1.0).abs() < 0.2,
+                "{}: {p:?} starts at {} (truth {want})",
+                tm.name,
+                v(p)
+            );
+        }
+        assert!(
+            (v(Parameter::Kxx) / truth.kx - 1.0).abs() < 0.05,
+            "{start:?}"
+        );
+        // and the fit lands within 3 standard errors of the truth
+        for (p, want) in [
+            (Parameter::Kxz, tc.kxz),
+            (Parameter::Kzx, tc.kzx),
+            (Parameter::Kxx, truth.kx),
+            (Parameter::Kzz, truth.kz),
+        ] {
+            let r = id.parameter(p).unwrap();
+            let (value, se) = (r.value.unwrap(), r.std_error.unwrap());
+            assert!(
+                (value - want).abs() < 3.0 * se,
+                "{}: {p:?} {value} +- {se} vs {want}",
+                tm.name
+            );
+        }
+    }
+}
