@@ -4,6 +4,7 @@ mod common;
 
 mod analysis;
 mod balance;
+mod balance_published;
 mod daqmx;
 mod dashboard;
 mod dashboard_browser;
