@@ -54,11 +54,13 @@ def test_bad_shapes_and_lengths(clean, table1):
 
 def test_time_grid_errors(clean, table1):
     cols = columns(clean)
-    cols["t"][500] += 1e-6
+    # five units of the 6th decimal off a 10 kHz grid: not rounding (one unit would be
+    # accepted as the stamps' printing, with a note: test_api.py)
+    cols["t"][500] += 5e-6
     with pytest.raises(ValueError, match=r"sample 500: sampling is not uniform"):
         rotorid.identify(cols, table1, method="algebraic")
-    # allowed with a larger tolerance (relative to dt)
-    rotorid.identify(cols, table1, method="algebraic", time_tolerance=0.02)
+    # allowed with a larger tolerance (relative to the fitted dt)
+    rotorid.identify(cols, table1, method="algebraic", time_tolerance=0.1)
     with pytest.raises(ValueError, match=r"time_tolerance = -1 is out of range"):
         rotorid.identify(clean, table1, method="algebraic", time_tolerance=-1)
 
@@ -77,11 +79,21 @@ def test_other_dtypes_and_layouts_give_the_same_result(clean, table1):
         res = rotorid.identify(data, table1, method="algebraic")
         assert res.to_dict() == ref.to_dict()
         assert_frame_equal(res.estimates, ref.estimates, check_exact=True)
-    # float32 is converted (other numbers, so only close)
+    # float32 is converted (other numbers, so only close). On a record with noise: the
+    # modulating method tests its model, and on an exact record float32's rounding is the
+    # only residual left, which is not white (it is judged inadequate, rightly: no
+    # measured record is that clean)
+    rng = np.random.default_rng(5)
+    for k in ("x", "z"):
+        cols[k] = cols[k] + 1e-3 * cols[k].std() * rng.standard_normal(len(cols[k]))
+    f64 = rotorid.identify(cols, table1, method="modulating")
     f32 = {k: v.astype(np.float32) for k, v in cols.items()}
     f32["t"] = cols["t"]  # float32 stamps are not uniform to 1e-6 of dt
     res = rotorid.identify(f32, table1, method="modulating")
+    assert res.warnings == f64.warnings == [], (res.warnings, f64.warnings)
     assert res.params["rel_error"].abs().max() < 1e-2
+    diff = (res.params["value"] - f64.params["value"]).abs() / f64.params["std_error"]
+    assert diff.max() < 0.1, diff
 
 
 def test_scenario_errors_name_the_key_and_range():
