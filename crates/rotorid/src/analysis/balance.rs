@@ -40,7 +40,7 @@ use nalgebra::{Complex, Matrix2, SMatrix};
 
 use crate::model::{check, RotorParams};
 
-use super::covariance::{values, CovarianceParameter, Gradient, ParameterCovariance};
+use super::covariance::{values, CovarianceParameter, Gradient, ParameterCovariance, NPARAM};
 use super::error::{check_params, check_speed, AnalysisError};
 use super::modes::C64;
 use super::one_x::OneX;
@@ -130,7 +130,7 @@ pub fn balance_from_unbalance(
         v[CovarianceParameter::MudSinAlpha.index()],
     );
     let unit = |q: CovarianceParameter| {
-        let mut g: Gradient = [0.0; 8];
+        let mut g: Gradient = [0.0; NPARAM];
         g[q.index()] = 1.0;
         g
     };

@@ -21,6 +21,7 @@
 //! d lambda / d theta = -r (dQ/dtheta) u / (r Q'(lambda) u),     Q'(lambda) = 2 lambda M + C1 + W C2
 //! dQ/dm = lambda^2 I     dQ/dcx = lambda E_11   dQ/dkx = E_11   (cz, kz: E_22)
 //! dQ/da = lambda W J     dQ/dW = lambda a J,    J = [[0, -1], [1, 0]]
+//! dQ/dcxz = lambda E_12  dQ/dkxz = E_12         (czx, kzx: E_21)
 //! ```
 //!
 //! The unbalance does not move the eigenvalues (its gradient entries are 0). At a double
@@ -34,6 +35,7 @@ use crate::model::{rad_per_s_to_rpm, RotorParams};
 use super::covariance::{std_of, CovarianceParameter, Gradient, ParameterCovariance, NPARAM};
 use super::error::{check_params, check_speeds, AnalysisError};
 use super::modes::{Mode, Quadratic, Whirl, C64};
+use super::stability::log_dec_gradient;
 
 /// Bisection stops when the bracket is narrower than this fraction of the speed.
 const BRACKET: f64 = 1e-13;
@@ -52,6 +54,11 @@ pub struct CriticalSpeed {
     pub mode: usize,
     /// The mode at W_c (its damped natural frequency equals W_c).
     pub at: Mode,
+    /// The standard deviation of its logarithmic decrement at W_c (dimensionless): the
+    /// total derivative d delta / d theta + (d delta / d W) (d W_c / d theta) propagated
+    /// under the covariance (the stability module's derivative of delta); `None` like
+    /// `std`, or when the mode does not oscillate.
+    pub log_dec_std: Option<f64>,
 }
 
 impl CriticalSpeed {
@@ -92,12 +99,20 @@ pub fn critical_speeds(
             if (prev.1 > 0.0) != (next.1 > 0.0) {
                 let wc = bisect(|w| g(i, w), prev, next);
                 let at = Quadratic::new(p, wc).modes()[i];
-                let std = gradient(p, wc, i).and_then(|grad| std_of(cov, &grad));
+                let grad = gradient(p, wc, i);
+                let std = grad.and_then(|grad| std_of(cov, &grad));
+                let log_dec_std = grad
+                    .zip(log_dec_gradient(p, wc, i))
+                    .and_then(|(gw, (gd, dw))| {
+                        let total: Gradient = std::array::from_fn(|k| gd[k] + dw * gw[k]);
+                        std_of(cov, &total)
+                    });
                 out.push(CriticalSpeed {
                     speed: wc,
                     std,
                     mode: i,
                     at,
+                    log_dec_std,
                 });
             }
             prev = next;
@@ -151,6 +166,8 @@ pub(crate) fn eigenvalue_derivatives(
     let j = Matrix2::new(zero, -one, one, zero);
     let e11 = Matrix2::new(one, zero, zero, zero);
     let e22 = Matrix2::new(zero, zero, zero, one);
+    let e12 = Matrix2::new(zero, one, zero, zero);
+    let e21 = Matrix2::new(zero, zero, one, zero);
     let d = |dq: Matrix2<C64>| -(r * dq * u)[(0, 0)] / denom;
     let mut out = [zero; NPARAM];
     out[CovarianceParameter::M.index()] = d(Matrix2::identity() * (l * l));
@@ -159,6 +176,10 @@ pub(crate) fn eigenvalue_derivatives(
     out[CovarianceParameter::Cz.index()] = d(e22 * l);
     out[CovarianceParameter::Kz.index()] = d(e22);
     out[CovarianceParameter::A.index()] = d(j * (l * w));
+    out[CovarianceParameter::Cxz.index()] = d(e12 * l);
+    out[CovarianceParameter::Czx.index()] = d(e21 * l);
+    out[CovarianceParameter::Kxz.index()] = d(e12);
+    out[CovarianceParameter::Kzx.index()] = d(e21);
     Some((out, d(j * (l * p.a))))
 }
 
