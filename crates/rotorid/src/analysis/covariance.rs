@@ -70,8 +70,9 @@ pub(crate) const NPARAM: usize = 12;
 pub(crate) type Gradient = [f64; NPARAM];
 
 impl CovarianceParameter {
-    /// Every parameter, in index order.
-    pub const ALL: [CovarianceParameter; NPARAM] = [
+    /// The Jeffcott rotor's parameters, in index order (those of a Jeffcott fit's
+    /// covariance; the cross-coupled model adds [`CovarianceParameter::CROSS`]).
+    pub const ALL: [CovarianceParameter; 8] = [
         CovarianceParameter::M,
         CovarianceParameter::Cx,
         CovarianceParameter::Kx,
@@ -80,11 +81,20 @@ impl CovarianceParameter {
         CovarianceParameter::A,
         CovarianceParameter::MudCosAlpha,
         CovarianceParameter::MudSinAlpha,
+    ];
+
+    /// The cross-coupled bearing coefficients, in index order (after [`CovarianceParameter::ALL`]).
+    pub const CROSS: [CovarianceParameter; 4] = [
         CovarianceParameter::Cxz,
         CovarianceParameter::Czx,
         CovarianceParameter::Kxz,
         CovarianceParameter::Kzx,
     ];
+
+    /// Every parameter of either model, in index order.
+    pub fn every() -> impl Iterator<Item = CovarianceParameter> {
+        Self::ALL.into_iter().chain(Self::CROSS)
+    }
 
     /// The name as the refinement writes it (`m`, ..., `mud_cos_alpha`, `mud_sin_alpha`).
     pub fn name(self) -> &'static str {
@@ -113,7 +123,7 @@ impl CovarianceParameter {
             "czz" => Some(CovarianceParameter::Cz),
             "kxx" => Some(CovarianceParameter::Kx),
             "kzz" => Some(CovarianceParameter::Kz),
-            _ => Self::ALL.into_iter().find(|p| p.name() == name),
+            _ => Self::every().find(|p| p.name() == name),
         }
     }
 
@@ -134,7 +144,7 @@ impl CovarianceParameter {
         }
     }
 
-    /// Position in [`CovarianceParameter::ALL`].
+    /// Position in [`CovarianceParameter::every`].
     pub(crate) fn index(self) -> usize {
         self as usize
     }
@@ -385,6 +395,17 @@ mod tests {
             assert_eq!(CovarianceParameter::from_name(p.name()), Some(p));
             assert_eq!(CovarianceParameter::ALL[p.index()], p);
         }
+        for (i, p) in CovarianceParameter::every().enumerate() {
+            assert_eq!(CovarianceParameter::from_name(p.name()), Some(p));
+            assert_eq!(p.index(), i);
+        }
+        assert_eq!(CovarianceParameter::every().count(), NPARAM);
+        assert_eq!(
+            CovarianceParameter::from_name("kxx"),
+            Some(CovarianceParameter::Kx)
+        );
+        let e = ParameterCovariance::new(names(&["kx", "kxx"]), vec![vec![1.0; 2]; 2]).unwrap_err();
+        assert!(matches!(e, AnalysisError::DuplicateParameter { .. }), "{e}");
         let e = ParameterCovariance::new(names(&["m", "k"]), vec![vec![1.0; 2]; 2]).unwrap_err();
         assert_eq!(
             e.to_string(),

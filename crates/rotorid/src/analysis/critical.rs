@@ -99,14 +99,9 @@ pub fn critical_speeds(
             if (prev.1 > 0.0) != (next.1 > 0.0) {
                 let wc = bisect(|w| g(i, w), prev, next);
                 let at = Quadratic::new(p, wc).modes()[i];
-                let grad = gradient(p, wc, i);
-                let std = grad.and_then(|grad| std_of(cov, &grad));
-                let log_dec_std = grad
-                    .zip(log_dec_gradient(p, wc, i))
-                    .and_then(|(gw, (gd, dw))| {
-                        let total: Gradient = std::array::from_fn(|k| gd[k] + dw * gw[k]);
-                        std_of(cov, &total)
-                    });
+                let std = gradient(p, wc, i).and_then(|grad| std_of(cov, &grad));
+                let log_dec_std = log_dec_gradient_at_critical(p, wc, i)
+                    .and_then(|grad| std_of(cov, &grad));
                 out.push(CriticalSpeed {
                     speed: wc,
                     std,
@@ -195,6 +190,14 @@ pub(crate) fn gradient(p: &RotorParams, wc: f64, i: usize) -> Option<Gradient> {
     grad.iter().all(|g| g.is_finite()).then_some(grad)
 }
 
+/// The gradient of the logarithmic decrement of mode `i` at its critical speed `wc` over
+/// the parameters: d delta / d theta + (d delta / d W) (d W_c / d theta).
+pub(crate) fn log_dec_gradient_at_critical(p: &RotorParams, wc: f64, i: usize) -> Option<Gradient> {
+    let gw = gradient(p, wc, i)?;
+    let (gd, dw) = log_dec_gradient(p, wc, i)?;
+    Some(std::array::from_fn(|k| gd[k] + dw * gw[k]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -276,6 +279,52 @@ mod tests {
                     "mode {} parameter {k}: {fd} vs {}",
                     c.mode,
                     grad[k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn cross_coupled_critical_log_dec_gradient_matches_central_differences() {
+        let mut p = crate::test_models::cross_coupled_rotor();
+        p.coupling = Some(crate::model::CrossCoupling {
+            cxz: 20.0,
+            czx: -12.0,
+            kxz: -3.0e4,
+            kzx: 4.0e4,
+        });
+        p.cz = 120.0;
+        let grid: Vec<f64> = (0..=60).map(|k| 10.0 * k as f64).collect();
+        let cs = critical_speeds(&p, None, &grid).unwrap();
+        assert_eq!(cs.len(), 2);
+        let v = values(&p);
+        for c in &cs {
+            let grad = log_dec_gradient_at_critical(&p, c.speed, c.mode).unwrap();
+            let wgrad = gradient(&p, c.speed, c.mode).unwrap();
+            for k in (0..NPARAM).filter(|&k| k != 6 && k != 7) {
+                let h = 1e-5 * v[k].abs();
+                let at = |x: f64| {
+                    let mut vv = v;
+                    vv[k] = x;
+                    let q = crate::analysis::covariance::with_values(&p, &vv);
+                    let cs = critical_speeds(&q, None, &grid).unwrap();
+                    let d = cs.iter().find(|d| d.mode == c.mode).unwrap();
+                    (d.at.log_dec.unwrap(), d.speed)
+                };
+                let (up, dn) = (at(v[k] + h), at(v[k] - h));
+                let fd = (up.0 - dn.0) / (2.0 * h);
+                assert!(
+                    (fd - grad[k]).abs() <= 1e-5 * grad[k].abs() + 1e-12 / h,
+                    "mode {} parameter {k}: {fd} vs {}",
+                    c.mode,
+                    grad[k]
+                );
+                let fd = (up.1 - dn.1) / (2.0 * h);
+                assert!(
+                    (fd - wgrad[k]).abs() <= 1e-5 * wgrad[k].abs() + 4.0 * BRACKET * c.speed / h,
+                    "critical speed, mode {} parameter {k}: {fd} vs {}",
+                    c.mode,
+                    wgrad[k]
                 );
             }
         }

@@ -93,6 +93,14 @@ pub struct Stability {
     /// True when the rotor is already unstable at the first speed of the range (the
     /// threshold is then that speed, not a crossing).
     pub unstable_at_start: bool,
+    /// After an instability, the speed \[rad/s\] from which the rotor is stable again to
+    /// the end of the range (the last crossing from unstable to stable, refined as the
+    /// threshold is); `None` when it is stable everywhere or unstable at the end. With
+    /// constant bearing coefficients and a > 0 the gyroscopic stiffening of the forward
+    /// mode can end an instability that starts at rest (module doc).
+    pub stable_from: Option<f64>,
+    /// Its standard deviation \[rad/s\] (as `threshold_std`).
+    pub stable_from_std: Option<f64>,
 }
 
 impl Stability {
@@ -212,8 +220,11 @@ pub fn stability_with_covariance(
         threshold_mode: None,
         threshold_whirl: None,
         unstable_at_start: false,
+        stable_from: None,
+        stable_from_std: None,
     };
     let mut last_stable: Option<(f64, f64)> = None;
+    let mut last_unstable: Option<f64> = None;
     for &w in speeds {
         let modes = Quadratic::new(p, w).modes();
         for (i, m) in modes.iter().enumerate() {
@@ -253,8 +264,22 @@ pub fn stability_with_covariance(
                 }
             }
         }
-        if !unstable {
+        if unstable {
+            out.stable_from = None;
+            out.stable_from_std = None;
+        } else {
+            if let Some(a) = last_unstable.filter(|&a| last_stable.is_none_or(|(s, _)| s < a)) {
+                let shift = if z > 0.0 { 0.0 } else { UNSTABLE_ZETA };
+                let ws = bisect(|w| zeta(w) + shift >= 0.0, a, w);
+                let below = (ws * (1.0 - 1e-9)).max(a);
+                let (i, _) = least_damped(p, below);
+                out.stable_from = Some(ws);
+                out.stable_from_std = threshold_gradient(p, ws, i).and_then(|g| std_of(cov, &g));
+            }
             last_stable = Some((w, z));
+        }
+        if unstable {
+            last_unstable = Some(w);
         }
     }
     Ok(out)
@@ -364,6 +389,11 @@ mod tests {
         let stable_from = (p.m * w * w - p.kx) / (2.871 * w);
         assert!(stability_margin(&p, None, stable_from * 0.999).unwrap().is_unstable());
         assert!(!stability_margin(&p, None, stable_from * 1.001).unwrap().is_unstable());
+        let got = s.stable_from.unwrap();
+        assert!((got / stable_from - 1.0).abs() < 1e-9, "{got} vs {stable_from}");
+        // the range ending inside the instability: not stable again
+        let s = stability(&p, &grid(stable_from * 0.9, 10.0)).unwrap();
+        assert_eq!(s.stable_from, None);
     }
 
     #[test]

@@ -7,6 +7,7 @@ mod acquisition;
 mod adequacy;
 mod algebraic_windows;
 mod analysis;
+mod analysis_cross;
 mod identify_accuracy;
 mod identify_conditioning;
 mod identify_convergence;
