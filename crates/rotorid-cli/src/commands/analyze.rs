@@ -630,7 +630,9 @@ fn instability_text(st: &Stability, cross: bool) -> String {
     let Some(t) = st.threshold else {
         return "stable over the range".to_string();
     };
-    let whirl = st.threshold_whirl.map_or("a".to_string(), |w| format!("the {}", w.name()));
+    let whirl = st
+        .threshold_whirl
+        .map_or("a".to_string(), |w| format!("the {}", w.name()));
     let mode = ["lower", "higher"][st.threshold_mode.unwrap_or(0).min(1)];
     let mut s = if st.unstable_at_start {
         format!(
@@ -708,8 +710,7 @@ pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
             n + 1,
             with_std(c.rpm(), c.std_rpm(), "rpm"),
             whirl_name(c.whirl()),
-            c.at
-                .log_dec
+            c.at.log_dec
                 .map_or("-".into(), |d| with_std_fixed(d, c.log_dec_std, 4))
         )?;
     }
@@ -729,7 +730,11 @@ pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
     }
     if let Some((m, src)) = &r.operating {
         let rpm = rad_per_s_to_rpm(m.speed);
-        let from = if *src == "given" { "--operating-rpm" } else { "the scenario's speed" };
+        let from = if *src == "given" {
+            "--operating-rpm"
+        } else {
+            "the scenario's speed"
+        };
         let d = m
             .log_dec()
             .map_or("- (the mode does not oscillate)".into(), |d| {

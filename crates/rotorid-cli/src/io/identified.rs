@@ -100,9 +100,9 @@ impl IdentifiedRotor {
             ModelKind::CrossCoupled => &CROSS_ROTOR_FIELDS,
         };
         let list = fields.iter().map(|f| f.0).collect::<Vec<_>>().join(", ");
-        let rotor = top.get("rotor").ok_or_else(|| {
-            anyhow!("{file}: missing field `rotor` (the identified {list})")
-        })?;
+        let rotor = top
+            .get("rotor")
+            .ok_or_else(|| anyhow!("{file}: missing field `rotor` (the identified {list})"))?;
         let Some(rotor) = rotor.as_object() else {
             bail!("{file}: field `rotor` must be an object with {list}");
         };
@@ -267,7 +267,10 @@ mod tests {
                            "matrix": [[1e-6, 0, 0, 0], [0, 4e4, 0, 0], [0, 0, 9e4, 0], [0, 0, 0, 1.6e5]]}}"#;
         let r = IdentifiedRotor::parse("c.json", text).unwrap();
         let p = r.params;
-        assert_eq!((p.m, p.cx, p.cz, p.kx, p.kz), (14.29, 200.0, 180.0, 1.195e6, 1.4e6));
+        assert_eq!(
+            (p.m, p.cx, p.cz, p.kx, p.kz),
+            (14.29, 200.0, 180.0, 1.195e6, 1.4e6)
+        );
         assert_eq!(
             p.coupling,
             Some(CrossCoupling {
@@ -287,7 +290,8 @@ mod tests {
                 .starts_with("c.json: missing field `rotor.kzx` (N/m; the cross-coupled model's rotor has m, cxx"),
             "{e}"
         );
-        let e = IdentifiedRotor::parse("c.json", &text.replace("cross_coupled", "jeffcot")).unwrap_err();
+        let e = IdentifiedRotor::parse("c.json", &text.replace("cross_coupled", "jeffcot"))
+            .unwrap_err();
         assert!(e.to_string().contains("field `model` must be"), "{e}");
     }
 }

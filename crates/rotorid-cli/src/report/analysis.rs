@@ -137,17 +137,17 @@ pub fn render_report(
     let rotor = rows
         .iter()
         .copied()
-    .map(|(name, unit)| RotorRow {
-        name,
-        value: num(&a["rotor"][name]).map_or("-".into(), |v| fmt_sig(v, 7)),
-        std: if a["rotor_std"].is_null() {
-            "-".into()
-        } else {
-            std_of(name)
-        },
-        unit,
-    })
-    .collect();
+        .map(|(name, unit)| RotorRow {
+            name,
+            value: num(&a["rotor"][name]).map_or("-".into(), |v| fmt_sig(v, 7)),
+            std: if a["rotor_std"].is_null() {
+                "-".into()
+            } else {
+                std_of(name)
+            },
+            unit,
+        })
+        .collect();
     let critical = a["critical_speeds"]
         .as_array()
         .map(|cs| {

@@ -181,7 +181,10 @@ pub(crate) fn values(p: &crate::model::RotorParams) -> Gradient {
 /// The rotor with the parameter values `v` (as [`values`] orders them), the unbalance
 /// from u_c, u_s at d = 1 m; cross-coupled when `p` is.
 #[cfg(test)]
-pub(crate) fn with_values(p: &crate::model::RotorParams, v: &Gradient) -> crate::model::RotorParams {
+pub(crate) fn with_values(
+    p: &crate::model::RotorParams,
+    v: &Gradient,
+) -> crate::model::RotorParams {
     crate::model::RotorParams {
         m: v[0],
         cx: v[1],

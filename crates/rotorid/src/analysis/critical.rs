@@ -100,8 +100,8 @@ pub fn critical_speeds(
                 let wc = bisect(|w| g(i, w), prev, next);
                 let at = Quadratic::new(p, wc).modes()[i];
                 let std = gradient(p, wc, i).and_then(|grad| std_of(cov, &grad));
-                let log_dec_std = log_dec_gradient_at_critical(p, wc, i)
-                    .and_then(|grad| std_of(cov, &grad));
+                let log_dec_std =
+                    log_dec_gradient_at_critical(p, wc, i).and_then(|grad| std_of(cov, &grad));
                 out.push(CriticalSpeed {
                     speed: wc,
                     std,

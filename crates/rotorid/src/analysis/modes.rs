@@ -402,8 +402,7 @@ mod tests {
         .map(|v| v / (m * m));
         let poly = |l: C64| (((l + c[3]) * l + c[2]) * l + c[1]) * l + c[0];
         let scale = (q.kx.max(q.kz) / m).sqrt();
-        let mut z: [C64; 4] =
-            std::array::from_fn(|k| C64::new(0.4, 0.9).powu(k as u32) * scale);
+        let mut z: [C64; 4] = std::array::from_fn(|k| C64::new(0.4, 0.9).powu(k as u32) * scale);
         for _ in 0..500 {
             for k in 0..4 {
                 let mut d = C64::new(1.0, 0.0);
@@ -495,7 +494,10 @@ mod tests {
         // a = 0: both modes have the same frequency; they differ in damping and whirl
         let ms = modes(&p, 100.0).unwrap();
         let forward = ms.iter().find(|m| m.whirl == Some(Whirl::Forward)).unwrap();
-        let backward = ms.iter().find(|m| m.whirl == Some(Whirl::Backward)).unwrap();
+        let backward = ms
+            .iter()
+            .find(|m| m.whirl == Some(Whirl::Backward))
+            .unwrap();
         for (mode, want) in [(backward, bwd), (forward, fwd)] {
             assert!(
                 (mode.eigenvalue - want).norm() < 1e-10 * want.norm(),

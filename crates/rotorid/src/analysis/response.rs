@@ -317,7 +317,8 @@ mod tests {
                 let (mut up, mut dn) = (v, v);
                 up[k] += h;
                 dn[k] -= h;
-                let at = |v| response_and_gradient(&super::super::covariance::with_values(&p, v), w);
+                let at =
+                    |v| response_and_gradient(&super::super::covariance::with_values(&p, v), w);
                 let fd = (at(&up).unwrap().0 - at(&dn).unwrap().0) / Complex::new(2.0 * h, 0.0);
                 assert!(
                     (fd - g[k]).norm() < 1e-6 * g[k].norm(),

@@ -259,8 +259,7 @@ pub fn stability_with_covariance(
                     out.threshold = Some(wt);
                     out.threshold_mode = Some(i);
                     out.threshold_whirl = m.whirl;
-                    out.threshold_std =
-                        threshold_gradient(p, wt, i).and_then(|g| std_of(cov, &g));
+                    out.threshold_std = threshold_gradient(p, wt, i).and_then(|g| std_of(cov, &g));
                 }
             }
         }
@@ -343,7 +342,9 @@ mod tests {
     }
 
     fn grid(max: f64, step: f64) -> Vec<f64> {
-        (0..=(max / step) as usize).map(|k| k as f64 * step).collect()
+        (0..=(max / step) as usize)
+            .map(|k| k as f64 * step)
+            .collect()
     }
 
     #[test]
@@ -379,18 +380,33 @@ mod tests {
         assert_eq!(m.1.whirl, Some(Whirl::Forward));
         assert_eq!(s.threshold_mode, Some(m.0));
         // and the margin changes sign there
-        assert!(stability_margin(&p, None, want * 0.999).unwrap().log_dec().unwrap() > 0.0);
-        assert!(stability_margin(&p, None, want * 1.001).unwrap().is_unstable());
+        assert!(
+            stability_margin(&p, None, want * 0.999)
+                .unwrap()
+                .log_dec()
+                .unwrap()
+                > 0.0
+        );
+        assert!(stability_margin(&p, None, want * 1.001)
+            .unwrap()
+            .is_unstable());
         // a > 0: unstable from rest (q > c w_n) up to the same formula's speed
         let p = isotropic(2.871, 6.0e4);
         let s = stability(&p, &grid(700.0, 10.0)).unwrap();
         assert!(s.unstable_at_start);
         let w = 6.0e4 / p.cx;
         let stable_from = (p.m * w * w - p.kx) / (2.871 * w);
-        assert!(stability_margin(&p, None, stable_from * 0.999).unwrap().is_unstable());
-        assert!(!stability_margin(&p, None, stable_from * 1.001).unwrap().is_unstable());
+        assert!(stability_margin(&p, None, stable_from * 0.999)
+            .unwrap()
+            .is_unstable());
+        assert!(!stability_margin(&p, None, stable_from * 1.001)
+            .unwrap()
+            .is_unstable());
         let got = s.stable_from.unwrap();
-        assert!((got / stable_from - 1.0).abs() < 1e-9, "{got} vs {stable_from}");
+        assert!(
+            (got / stable_from - 1.0).abs() < 1e-9,
+            "{got} vs {stable_from}"
+        );
         // the range ending inside the instability: not stable again
         let s = stability(&p, &grid(stable_from * 0.9, 10.0)).unwrap();
         assert_eq!(s.stable_from, None);

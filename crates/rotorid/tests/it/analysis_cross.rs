@@ -112,9 +112,7 @@ const NAMES: [&str; 10] = [
 
 fn vector(p: &RotorParams) -> [f64; 10] {
     let c = p.cross();
-    [
-        p.m, p.cx, p.kx, p.cz, p.kz, p.a, c.cxz, c.czx, c.kxz, c.kzx,
-    ]
+    [p.m, p.cx, p.kx, p.cz, p.kz, p.a, c.cxz, c.czx, c.kxz, c.kzx]
 }
 
 fn from_vector(v: &DVector<f64>) -> RotorParams {
@@ -160,7 +158,13 @@ fn analysis_threshold_and_log_dec_std_agree_with_monte_carlo() {
         300.0,
     ];
     let mut cov = DMatrix::from_fn(10, 10, |i, j| if i == j { sd[i] * sd[i] } else { 0.0 });
-    for (i, j, r) in [(0, 2, 0.8), (0, 4, 0.7), (2, 4, 0.6), (8, 9, -0.5), (1, 3, 0.3)] {
+    for (i, j, r) in [
+        (0, 2, 0.8),
+        (0, 4, 0.7),
+        (2, 4, 0.6),
+        (8, 9, -0.5),
+        (1, 3, 0.3),
+    ] {
         cov[(i, j)] = r * sd[i] * sd[j];
         cov[(j, i)] = r * sd[i] * sd[j];
     }
@@ -212,7 +216,10 @@ fn analysis_threshold_and_log_dec_std_agree_with_monte_carlo() {
             cs[1].log_dec_std.unwrap(),
         ),
     ] {
-        println!("{label}: Monte Carlo {mc:.4e}, linearised {linear:.4e}, ratio {:.4}", mc / linear);
+        println!(
+            "{label}: Monte Carlo {mc:.4e}, linearised {linear:.4e}, ratio {:.4}",
+            mc / linear
+        );
         assert!(
             (mc / linear - 1.0).abs() < 0.10,
             "{label}: {mc} vs {linear}"
