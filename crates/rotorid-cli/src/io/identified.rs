@@ -35,7 +35,7 @@ use rotorid::{RotorParams, Unbalance};
 use serde_json::Value;
 
 /// The rotor parameters in `rotor`, in order, with their units.
-const ROTOR_FIELDS: [(&str, &str); 8] = [
+pub(crate) const ROTOR_FIELDS: [(&str, &str); 8] = [
     ("m", "kg"),
     ("cx", "N s/m"),
     ("kx", "N/m"),
@@ -47,7 +47,7 @@ const ROTOR_FIELDS: [(&str, &str); 8] = [
 ];
 
 /// The cross-coupled model's `rotor` fields, in the summary's order.
-const CROSS_ROTOR_FIELDS: [(&str, &str); 12] = [
+pub(crate) const CROSS_ROTOR_FIELDS: [(&str, &str); 12] = [
     ("m", "kg"),
     ("cxx", "N s/m"),
     ("cxz", "N s/m"),

@@ -12,6 +12,7 @@ use minijinja::Environment;
 use serde::Serialize;
 use serde_json::Value;
 
+use crate::io::identified::{CROSS_ROTOR_FIELDS, ROTOR_FIELDS};
 use crate::io::number::format_sig as fmt_sig;
 use crate::plot::campbell::with_std;
 
@@ -109,34 +110,23 @@ pub fn render_report(
         }
     };
     let cross = a["model"].as_str() == Some("cross_coupled");
-    let jeffcott_rows = [
-        ("m", "kg"),
-        ("cx", "N s/m"),
-        ("kx", "N/m"),
-        ("cz", "N s/m"),
-        ("kz", "N/m"),
-        ("a", "N s\u{b2}/m"),
-        ("mud", "kg m"),
-        ("alpha", "rad"),
-    ];
-    let cross_rows = [
-        ("m", "kg"),
-        ("cxx", "N s/m"),
-        ("cxz", "N s/m"),
-        ("czx", "N s/m"),
-        ("czz", "N s/m"),
-        ("kxx", "N/m"),
-        ("kxz", "N/m"),
-        ("kzx", "N/m"),
-        ("kzz", "N/m"),
-        ("a", "N s\u{b2}/m"),
-        ("mud", "kg m"),
-        ("alpha", "rad"),
-    ];
-    let rows: &[(&str, &str)] = if cross { &cross_rows } else { &jeffcott_rows };
+    let rows: &[(&str, &str)] = if cross {
+        &CROSS_ROTOR_FIELDS
+    } else {
+        &ROTOR_FIELDS
+    };
     let rotor = rows
         .iter()
-        .copied()
+        .map(|&(name, unit)| {
+            (
+                name,
+                if unit == "N s^2/m" {
+                    "N s\u{b2}/m"
+                } else {
+                    unit
+                },
+            )
+        })
         .map(|(name, unit)| RotorRow {
             name,
             value: num(&a["rotor"][name]).map_or("-".into(), |v| fmt_sig(v, 7)),
