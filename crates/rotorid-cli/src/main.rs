@@ -53,8 +53,12 @@ enum Command {
     Plot(commands::plot::PlotArgs),
     /// Campbell diagram, critical speeds, stability and unbalance response, with uncertainty.
     Analyze(commands::analyze::AnalyzeArgs),
-    /// Correction mass for single-plane balancing (identified unbalance or two runs).
-    Balance(commands::balance::BalanceArgs),
+    /// Correction masses with their uncertainty: multi-plane, multi-speed influence
+    /// coefficients (least squares or min-max, split into holes, trial planning), or one
+    /// plane from an identified unbalance or two runs.
+    Balance(Box<commands::balance::BalanceArgs>),
+    /// The 1X vector of each probe of raw records (probes, keyphasor) as vectors.csv rows.
+    Onex(commands::onex::OnexArgs),
     /// Turn a raw acquisition (probe volts, keyphasor, slow roll) into a response CSV.
     Condition(commands::condition::ConditionArgs),
     /// List the channels of a record (CSV, MAT, TDMS, UFF58, NPY/NPZ, Parquet).
@@ -62,6 +66,7 @@ enum Command {
     Publish(commands::publish::PublishArgs),
     Worker(commands::worker::WorkerArgs),
     Fleet(commands::fleet::FleetArgs),
+    Dashboard(commands::dashboard::DashboardArgs),
 }
 
 fn main() {
@@ -73,12 +78,14 @@ fn main() {
         Command::Paper(args) => commands::paper::run(args),
         Command::Plot(args) => commands::plot::run(args),
         Command::Analyze(args) => commands::analyze::run(args),
-        Command::Balance(args) => commands::balance::run(args),
+        Command::Balance(args) => commands::balance::run(*args),
+        Command::Onex(args) => commands::onex::run(args),
         Command::Condition(args) => commands::condition::run(args),
         Command::Inspect(args) => commands::inspect::run(args),
         Command::Publish(args) => commands::publish::run(args),
         Command::Worker(args) => commands::worker::run(args),
         Command::Fleet(args) => commands::fleet::run(args),
+        Command::Dashboard(args) => commands::dashboard::run(args),
     };
     if let Err(err) = result {
         if err.is::<io::StdoutClosed>() {

@@ -17,6 +17,14 @@
 //! parameter and window pair); the test in tests/drift.rs measures the rate on unchanged
 //! machines and reports the largest |z| it saw.
 //!
+//! **Model alerts.** A window whose identification says the model does not explain it
+//! (`Finding::ModelInadequate`: its values are withheld, so it has no estimates to test)
+//! is remembered; two consecutive such windows raise a [`ModelAlert`] on the later one
+//! (one window's verdict was a false alarm in 2 of 2100 records of correct models at 20,
+//! 40 and 60 dB, crates/rotorid/tests/it/adequacy.rs; two consecutive ones, ~1e-6), with
+//! `Nats-Msg-Id = <ID>/<window>/model`: a rotor that stopped behaving like eq. (1) (a rub,
+//! a crack, a loose support) is alerted within two windows.
+//!
 //! Windows are processed out of order by several workers, so the state (below) lives in
 //! the key-value bucket `ROTORID_DRIFT` under the machine's id and is updated by
 //! compare-and-set; a window that arrives before the baseline is complete is held and
@@ -25,10 +33,10 @@
 
 use std::collections::BTreeMap;
 
-use rotorid::pipeline::Identification;
+use rotorid::pipeline::{Finding, Identification};
 use serde::{Deserialize, Serialize};
 
-use crate::result::{AlertRecord, FLEET_SCHEMA};
+use crate::result::{AlertRecord, ModelAlert, FLEET_SCHEMA, MODEL_INADEQUATE};
 
 /// Windows of z history kept (the newest window number minus this is forgotten).
 pub const HISTORY_WINDOWS: u64 = 64;
@@ -114,6 +122,24 @@ pub struct DriftState {
     pub alerted: Vec<(u64, String)>,
     /// The baseline was given (SUMMARY), not formed from windows: every window is tested.
     pub given: bool,
+    /// Recent windows the model did not explain, by window number: (t0 \[s\], message).
+    #[serde(default)]
+    pub inadequate: BTreeMap<u64, (f64, String)>,
+    /// Windows a model alert was raised on, recent ones.
+    #[serde(default)]
+    pub model_alerted: Vec<u64>,
+}
+
+/// The `MODEL INADEQUATE` messages of `ident` joined by ` | `, `None` when the model
+/// explained the record (or was not judged).
+pub fn model_inadequate(ident: &Identification) -> Option<String> {
+    let m: Vec<&str> = ident
+        .diagnostics
+        .iter()
+        .filter(|d| matches!(d.finding, Finding::ModelInadequate { .. }))
+        .map(|d| d.message.as_str())
+        .collect();
+    (!m.is_empty()).then(|| m.join(" | "))
 }
 
 impl DriftState {
@@ -157,6 +183,47 @@ impl DriftState {
         self.confirm(machine, s)
     }
 
+    /// Take window `window`'s model verdict (`inadequate`: its `MODEL INADEQUATE`
+    /// messages, see [`model_inadequate`]; `None` when the model explained it or it gave no
+    /// result); returns the model alert it newly confirms (module doc).
+    pub fn observe_model(
+        &mut self,
+        machine: &str,
+        window: u64,
+        t0_s: f64,
+        inadequate: Option<String>,
+    ) -> Vec<ModelAlert> {
+        let Some(message) = inadequate else {
+            return Vec::new();
+        };
+        self.inadequate.insert(window, (t0_s, message));
+        self.prune();
+        // the pairs this window completes, with the window before or after it
+        let mut alerts = Vec::new();
+        for w in [window, window + 1] {
+            let (Some(prev), Some((t0, msg))) = (
+                w.checked_sub(1).filter(|p| self.inadequate.contains_key(p)),
+                self.inadequate.get(&w),
+            ) else {
+                continue;
+            };
+            if self.model_alerted.contains(&w) {
+                continue;
+            }
+            self.model_alerted.push(w);
+            alerts.push(ModelAlert {
+                fleet_schema: FLEET_SCHEMA,
+                kind: MODEL_INADEQUATE.to_owned(),
+                machine: machine.to_owned(),
+                window: w,
+                t0_s: *t0,
+                previous_window: prev,
+                message: msg.clone(),
+            });
+        }
+        alerts
+    }
+
     fn test(&mut self, window: u64, t0_s: f64, estimates: Vec<Estimate>) {
         let Some(base) = &self.baseline else { return };
         let z = estimates
@@ -171,16 +238,22 @@ impl DriftState {
     }
 
     fn prune(&mut self) {
-        let newest = [self.tested.keys().last(), self.held.keys().last()]
-            .into_iter()
-            .flatten()
-            .max()
-            .copied()
-            .unwrap_or(0);
+        let newest = [
+            self.tested.keys().last(),
+            self.held.keys().last(),
+            self.inadequate.keys().last(),
+        ]
+        .into_iter()
+        .flatten()
+        .max()
+        .copied()
+        .unwrap_or(0);
         let oldest = newest.saturating_sub(HISTORY_WINDOWS);
         self.tested.retain(|&w, _| w >= oldest);
         self.held.retain(|&w, _| w >= oldest);
         self.alerted.retain(|(w, _)| *w >= oldest);
+        self.inadequate.retain(|&w, _| w >= oldest);
+        self.model_alerted.retain(|&w| w >= oldest);
     }
 
     /// Alerts for every pair of consecutive tested windows both over the threshold with the
@@ -296,6 +369,39 @@ mod tests {
         assert_eq!(a[0].window, 6);
         assert!(a[0].z < -5.0 && a[0].previous_z < -5.0);
         assert!((a[0].baseline - 100.0 - 1.0 / 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn two_consecutive_inadequate_windows_alert_once_in_any_order() {
+        let bad = |w: u64| Some(format!("MODEL INADEQUATE in window {w}"));
+        for order in [[3u64, 4, 5, 8], [5, 8, 4, 3], [8, 4, 5, 3]] {
+            let mut st = DriftState::default();
+            let mut alerts = Vec::new();
+            for w in order {
+                alerts.extend(st.observe_model("m1", w, w as f64, bad(w)));
+                // a window the model explained, and one delivered again, change nothing
+                assert!(st.observe_model("m1", 20, 20.0, None).is_empty());
+                let again: Vec<u64> = st
+                    .observe_model("m1", w, w as f64, bad(w))
+                    .iter()
+                    .map(|a| a.window)
+                    .collect();
+                assert!(again.is_empty(), "{again:?}");
+            }
+            let mut windows: Vec<(u64, u64)> = alerts
+                .iter()
+                .map(|a| (a.previous_window, a.window))
+                .collect();
+            windows.sort();
+            // 3-4 and 4-5 are consecutive, 8 alone raises nothing
+            assert_eq!(windows, vec![(3, 4), (4, 5)], "{order:?}");
+            assert!(alerts.iter().all(|a| a.kind == MODEL_INADEQUATE));
+            let a = alerts.iter().find(|a| a.window == 5).unwrap();
+            assert_eq!(
+                (a.t0_s, a.message.as_str()),
+                (5.0, "MODEL INADEQUATE in window 5")
+            );
+        }
     }
 
     #[test]

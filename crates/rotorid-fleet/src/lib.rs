@@ -29,7 +29,9 @@ pub mod worker;
 
 pub use error::FleetError;
 pub use frame::{Channel, Frame, FrameError};
-pub use result::{AlertRecord, ErrorRecord, WindowResult, FLEET_SCHEMA};
+pub use result::{
+    AlertRecord, ErrorRecord, ModelAlert, WindowResult, FLEET_SCHEMA, MODEL_INADEQUATE,
+};
 
 /// The stream of raw windows (subjects `rotorid.raw.>`).
 pub const RAW_STREAM: &str = "ROTORID_RAW";

@@ -1,6 +1,7 @@
 //! What the workers publish (JSON): one [`WindowResult`] per identified window, one
-//! [`ErrorRecord`] per window that gives none, one [`AlertRecord`] per drift alert. These
-//! structs are the contract: `rotorid fleet status` and any consumer read them back.
+//! [`ErrorRecord`] per window that gives none, one [`AlertRecord`] per drift alert, one
+//! [`ModelAlert`] when the model stops explaining a machine's windows. These structs are
+//! the contract: `rotorid fleet status` and any consumer read them back.
 
 use rotorid::pipeline::Identification;
 use serde::{Deserialize, Serialize};
@@ -78,3 +79,28 @@ pub struct AlertRecord {
     /// The z of the window before (the confirmation).
     pub previous_z: f64,
 }
+
+/// A model alert (subject `rotorid.alert.<ID>`, `Nats-Msg-Id` `<ID>/<window>/model`): two
+/// consecutive windows whose identification found that eq. (1) does not explain them
+/// (`MODEL INADEQUATE`: their values were withheld), raised on the later one (see
+/// [`crate::drift`]). Tell it from an [`AlertRecord`] by its `kind`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelAlert {
+    /// [`FLEET_SCHEMA`].
+    pub fleet_schema: u32,
+    /// `model_inadequate`.
+    pub kind: String,
+    /// Machine id.
+    pub machine: String,
+    /// The window that confirmed it.
+    pub window: u64,
+    /// Its t0 \[s\].
+    pub t0_s: f64,
+    /// The window before it, also inadequate.
+    pub previous_window: u64,
+    /// The window's `MODEL INADEQUATE` messages (per channel), joined by ` | `.
+    pub message: String,
+}
+
+/// The `kind` of a [`ModelAlert`].
+pub const MODEL_INADEQUATE: &str = "model_inadequate";

@@ -1,6 +1,7 @@
 //! `rotorid fleet status`: per machine, the windows published, identified, dead-lettered
 //! and alerted (subject counts of the streams), the newest result from `ROTORID_LATEST`
-//! and the last alert; for the workers' consumer, the windows pending.
+//! with its warnings (a `MODEL INADEQUATE` window's withheld values among them) and the
+//! last alert (drift or model); for the workers' consumer, the windows pending.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -10,7 +11,8 @@ use futures_util::TryStreamExt as _;
 use crate::drift;
 use crate::error::FleetError;
 use crate::nats::Fleet;
-use crate::result::{AlertRecord, WindowResult};
+use crate::result::{AlertRecord, ModelAlert, WindowResult, MODEL_INADEQUATE};
+use rotorid::pipeline::Severity;
 
 /// One machine's line.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -27,8 +29,10 @@ pub struct MachineStatus {
     pub alerts: u64,
     /// The newest result.
     pub latest: Option<WindowResult>,
-    /// The newest alert.
+    /// The newest alert, when it is a drift alert.
     pub last_alert: Option<AlertRecord>,
+    /// The newest alert, when it is a model alert.
+    pub last_model_alert: Option<ModelAlert>,
 }
 
 /// The workers' consumer.
@@ -117,7 +121,12 @@ pub async fn status(fleet: &Fleet, durable: &str) -> Result<FleetStatus, FleetEr
                 .get_last_raw_message_by_subject(&crate::alert_subject(id))
                 .await
             {
-                m.last_alert = serde_json::from_slice(&msg.payload).ok();
+                m.last_model_alert = serde_json::from_slice::<ModelAlert>(&msg.payload)
+                    .ok()
+                    .filter(|a| a.kind == MODEL_INADEQUATE);
+                if m.last_model_alert.is_none() {
+                    m.last_alert = serde_json::from_slice(&msg.payload).ok();
+                }
             }
         }
         machines.push(m);
@@ -184,6 +193,18 @@ pub fn render(s: &FleetStatus) -> String {
                     e.parameter, e.value, e.std_error, e.unit
                 );
             }
+            for d in &r.identification.diagnostics {
+                if d.severity == Severity::Warning {
+                    let _ = writeln!(out, "    warning: {}", d.message);
+                }
+            }
+        }
+        if let Some(a) = &m.last_model_alert {
+            let _ = writeln!(
+                out,
+                "    MODEL ALERT windows {} and {} (t0 = {} s): {}",
+                a.previous_window, a.window, a.t0_s, a.message
+            );
         }
         if let Some(a) = &m.last_alert {
             let _ = writeln!(

@@ -80,6 +80,18 @@ impl Server {
         self.spawn();
     }
 
+    /// SIGKILL the server and leave it down (until [`Server::resume`]).
+    pub fn stop(&mut self) {
+        self.kill();
+    }
+
+    /// Start a stopped server again on the same port and store.
+    pub fn resume(&mut self) {
+        if self.child.is_none() {
+            self.spawn();
+        }
+    }
+
     fn kill(&mut self) {
         if let Some(mut c) = self.child.take() {
             let _ = c.kill();

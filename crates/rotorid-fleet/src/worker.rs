@@ -10,7 +10,8 @@
 //! 4. update `ROTORID_LATEST` key `<ID>` by compare-and-set, only when the window's number
 //!    is higher than the stored one's (window numbers order a machine's windows: they
 //!    increase with time);
-//! 5. update the drift state and publish any alert ([`crate::drift`]);
+//! 5. update the drift state and publish any alert ([`crate::drift`]: a parameter that
+//!    left its baseline, or two consecutive windows the model does not explain);
 //! 6. acknowledge the window.
 //!
 //! A worker killed anywhere before 6 leaves the window unacknowledged: after the ack wait
@@ -88,6 +89,11 @@ pub struct WorkerConfig {
     /// Print on stderr a line when a window is taken and one when it is done (just before
     /// its acknowledgement), and every dead letter and alert.
     pub verbose: bool,
+    /// A hook for tests that kill a worker: after taking this many windows, hold the last
+    /// one unacknowledged for ever (until the process is killed), having written
+    /// `holding window W of machine M (delivery D)` on stderr, so that a kill provably
+    /// lands on a window the server must redeliver. `None` (the default): never.
+    pub hold_after: Option<u64>,
 }
 
 impl WorkerConfig {
@@ -103,6 +109,7 @@ impl WorkerConfig {
             ack_wait: Duration::from_secs(30),
             max_deliveries: 5,
             verbose: false,
+            hold_after: None,
         }
     }
 }
@@ -181,6 +188,8 @@ struct Worker<'a> {
     drift: kv::Store,
     setups: HashMap<String, Arc<Setup>>,
     stats: WorkerStats,
+    /// Windows taken (for [`WorkerConfig::hold_after`]).
+    taken: u64,
 }
 
 /// Check the setup and create the streams, buckets and the consumer (all idempotent), so
@@ -230,6 +239,7 @@ pub async fn run(
         drift: fleet.drift().await?,
         setups: HashMap::new(),
         stats: WorkerStats::default(),
+        taken: 0,
     };
     tokio::pin!(shutdown);
     loop {
@@ -327,6 +337,15 @@ impl Worker<'_> {
                 frame.window, frame.machine
             );
         }
+        self.taken += 1;
+        if self.cfg.hold_after.is_some_and(|n| self.taken >= n) {
+            eprintln!(
+                "holding window {} of machine {} (delivery {delivered})",
+                frame.window, frame.machine
+            );
+            // unacknowledged until the process is killed (WorkerConfig::hold_after)
+            std::future::pending::<()>().await;
+        }
         if delivered > self.cfg.max_deliveries {
             let r = dead(
                 &frame.machine,
@@ -344,9 +363,9 @@ impl Worker<'_> {
             Ok(setup) => self.identify(&msg, frame.clone(), setup).await,
             Err(e) => Err(e),
         };
-        let estimates = match ident {
+        let (estimates, inadequate) = match ident {
             Ok(ident) => {
-                let est = drift::estimates(&ident);
+                let est = (drift::estimates(&ident), drift::model_inadequate(&ident));
                 let result = WindowResult {
                     fleet_schema: FLEET_SCHEMA,
                     machine: frame.machine.clone(),
@@ -363,10 +382,10 @@ impl Worker<'_> {
             Err(e) => {
                 let r = dead(&frame.machine, Some(frame.window), e.to_string());
                 self.publish_error(&r).await?;
-                Vec::new()
+                (Vec::new(), None)
             }
         };
-        self.observe_drift(&frame, estimates).await?;
+        self.observe_drift(&frame, estimates, inadequate).await?;
         if self.cfg.verbose {
             eprintln!(
                 "window {} of machine {} (stream seq {stream_seq}, delivery {delivered}) done",
@@ -492,6 +511,7 @@ impl Worker<'_> {
         &mut self,
         frame: &Frame,
         estimates: Vec<drift::Estimate>,
+        inadequate: Option<String>,
     ) -> Result<(), FleetError> {
         let machine = &frame.machine;
         let op = format!("update {} {machine}", crate::DRIFT_BUCKET);
@@ -509,6 +529,21 @@ impl Worker<'_> {
                 estimates.clone(),
                 &self.cfg.drift,
             );
+            let model_alerts =
+                state.observe_model(machine, frame.window, frame.t0, inadequate.clone());
+            for a in &model_alerts {
+                let json = serde_json::to_vec(a).unwrap_or_default();
+                let id = format!("{}/model", message_id(machine, a.window));
+                self.fleet
+                    .publish(&alert_subject(machine), &id, Bytes::from(json))
+                    .await?;
+                if self.cfg.verbose {
+                    eprintln!(
+                        "MODEL ALERT machine {machine} windows {} and {}: {}",
+                        a.previous_window, a.window, a.message
+                    );
+                }
+            }
             for a in &alerts {
                 let json = serde_json::to_vec(a).unwrap_or_default();
                 let id = format!("{}/{}", message_id(machine, a.window), a.parameter);
@@ -531,7 +566,7 @@ impl Worker<'_> {
                 Some(e) => self.drift.update(machine, json, e.revision).await.is_ok(),
             };
             if written {
-                self.stats.alerts += alerts.len() as u64;
+                self.stats.alerts += (alerts.len() + model_alerts.len()) as u64;
                 return Ok(());
             }
             tokio::time::sleep(Duration::from_millis(20)).await;

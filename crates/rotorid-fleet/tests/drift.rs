@@ -1,7 +1,9 @@
 //! Drift alerts with a real nats-server and two in-process workers: a machine whose kx drops
 //! by 5 % half-way alerts within two windows; 20 unchanged machines raise no alert over
-//! 10 s. Prints the largest |z| of the unchanged machines (the margin to a false alarm).
-//! Then `fleet status` agrees with the streams: every machine's windows, latest, alerts.
+//! 10 s; a machine whose x support stands on an unmodelled foundation (eq. (1) does not
+//! describe it) raises a model alert and no drift alert. Prints the largest |z| of the
+//! unchanged machines (the margin to a false alarm). Then `fleet status` agrees with the
+//! streams: every machine's windows, latest, alerts, the wrong model's warnings.
 
 mod common;
 
@@ -16,7 +18,9 @@ use rotorid_fleet::publish::{publish_frames, Rate};
 use rotorid_fleet::status::{render, status};
 use rotorid_fleet::window::windows;
 use rotorid_fleet::worker::{run, Scenarios, WorkerConfig};
-use rotorid_fleet::{AlertRecord, Channel, ALERT_STREAM, IDENT_STREAM};
+use rotorid_fleet::{
+    AlertRecord, Channel, ModelAlert, ALERT_STREAM, IDENT_STREAM, MODEL_INADEQUATE,
+};
 
 const UNCHANGED: usize = 20;
 const WINDOW: usize = 10_000;
@@ -54,6 +58,22 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
         let r = response(&s, 1000 + i as u64);
         all.push(windows(&id, 0.0, 1e-4, &probes(&r), WINDOW, 0).unwrap());
     }
+    // the wrong model: 5 s of table1 on a 5 kg foundation, 40 dB
+    let table1 = scenario(rotorid::model::Rotor::table1().params(), 5.0);
+    std::fs::write(scenarios.join("rub.toml"), scenario_toml(&table1)).unwrap();
+    let mut wrong = defects::simulate_defective_for(defects::DEFECTS[1], 5.0);
+    for v in [
+        &mut wrong.t,
+        &mut wrong.x,
+        &mut wrong.z,
+        &mut wrong.phi,
+        &mut wrong.phi_dot,
+        &mut wrong.phi_ddot,
+    ] {
+        v.truncate(50_000);
+    }
+    rotorid::simulate::add_noise(&mut wrong, 40.0, 77).unwrap();
+    all.push(windows("rub", 0.0, 1e-4, &probes(&wrong), WINDOW, 0).unwrap());
     let total: usize = all.iter().map(Vec::len).sum::<usize>() + 2;
     for frames in &all {
         publish_frames(&fleet, frames, Rate::Max, |_| {})
@@ -128,11 +148,33 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
     let stream = fleet.js.get_stream(ALERT_STREAM).await.unwrap();
     let last = stream.get_info().await.unwrap().state.last_sequence;
     let mut alerts: Vec<AlertRecord> = Vec::new();
+    let mut model_alerts: Vec<ModelAlert> = Vec::new();
     for seq in 1..=last {
         if let Ok(m) = stream.direct_get(seq).await {
-            alerts.push(serde_json::from_slice(&m.payload).unwrap());
+            match serde_json::from_slice::<ModelAlert>(&m.payload) {
+                Ok(a) => model_alerts.push(a),
+                Err(_) => alerts.push(serde_json::from_slice(&m.payload).unwrap()),
+            }
         }
     }
+    for a in &model_alerts {
+        eprintln!(
+            "model alert: {} windows {} and {}: {}",
+            a.machine, a.previous_window, a.window, a.message
+        );
+    }
+    // every window of the wrong model is flagged: windows 1..4 each confirm with the one
+    // before; nothing else raises one
+    assert!(
+        model_alerts.iter().all(|a| a.machine == "rub"),
+        "{model_alerts:?}"
+    );
+    let mut confirmed: Vec<u64> = model_alerts.iter().map(|a| a.window).collect();
+    confirmed.sort();
+    assert_eq!(confirmed, vec![1, 2, 3, 4]);
+    assert!(model_alerts
+        .iter()
+        .all(|a| a.kind == MODEL_INADEQUATE && a.message.contains("MODEL INADEQUATE")));
     for a in &alerts {
         eprintln!(
             "alert: {} window {} {} {:+.2} % z = {:.1} (previous {:.1})",
@@ -165,12 +207,22 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
     let kv = fleet.drift().await.unwrap();
     let mut keys = kv.keys().await.unwrap();
     let (mut zmax, mut over, mut tests) = (0.0f64, 0, 0);
+    // windows of unchanged machines the model was judged not to explain: a false alarm
+    // each (2 in 2100 records of correct models in the library's study), which withholds
+    // that window's values, so it gives the drift test nothing and alerts nothing alone
+    let (mut false_inadequate, mut untested) = (Vec::new(), 0);
     while let Some(k) = keys.next().await {
         let k = k.unwrap();
         if k == "drift" {
             continue;
         }
         let st: DriftState = serde_json::from_slice(&kv.get(&k).await.unwrap().unwrap()).unwrap();
+        if k != "rub" {
+            for (w, (_, message)) in &st.inadequate {
+                false_inadequate.push(format!("{k} window {w}: {message}"));
+                untested += usize::from(*w >= 3);
+            }
+        }
         for t in st.tested.values() {
             for (_, z) in &t.z {
                 tests += 1;
@@ -186,9 +238,15 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
         false_alarms.len(),
         100.0 * rel
     );
+    eprintln!(
+        "unchanged windows judged inadequate: {} of {}: {false_inadequate:?}",
+        false_inadequate.len(),
+        UNCHANGED * 10
+    );
+    assert!(false_inadequate.len() <= 2, "{false_inadequate:?}");
     assert_eq!(
         tests,
-        UNCHANGED * 7 * 6,
+        (UNCHANGED * 7 - untested) * 6,
         "windows 3..9, six parameters each"
     );
     assert!(false_alarms.is_empty(), "false alarms: {false_alarms:?}");
@@ -196,13 +254,27 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
     // what `rotorid fleet status` shows
     let st = status(&fleet, "drift").await.unwrap();
     eprintln!("{}", render(&st));
-    assert_eq!(st.machines.len(), UNCHANGED + 3, "with junk and other");
+    assert_eq!(st.machines.len(), UNCHANGED + 4, "with junk, other and rub");
+    let rub = st.machines.iter().find(|m| m.machine == "rub").unwrap();
+    assert_eq!(
+        (rub.published, rub.identified, rub.alerts),
+        (5, 5, 4),
+        "rub's windows and model alerts"
+    );
+    assert_eq!(rub.last_model_alert.as_ref().map(|a| a.window), Some(4));
+    let text = render(&st);
+    let block = &text[text.find("\nrub ").expect("rub's block")..];
+    assert!(
+        block.contains("warning: MODEL INADEQUATE")
+            && block.contains("MODEL ALERT windows 3 and 4"),
+        "{block}"
+    );
     let c = st.consumer.as_ref().expect("the workers' consumer");
     assert_eq!((c.pending, c.ack_pending), (0, 0));
     for m in st
         .machines
         .iter()
-        .filter(|m| m.machine != "junk" && m.machine != "other")
+        .filter(|m| !["junk", "other", "rub"].contains(&m.machine.as_str()))
     {
         assert_eq!(
             (m.published, m.identified, m.errors),

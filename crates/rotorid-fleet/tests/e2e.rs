@@ -1,6 +1,8 @@
 //! End to end with a real nats-server: 20 machines x 10 s of 10 kHz data, two worker
-//! processes; one is SIGKILLed while it holds an unacknowledged window, and restarted; the
-//! server is SIGKILLed and restarted once. Afterwards every window of every machine has exactly one result in
+//! processes; one is SIGKILLed while it holds an unacknowledged window (it announces the
+//! window it holds and holds it for ever: `WorkerConfig::hold_after`, so the kill cannot
+//! miss), and restarted; once that window has come back and been identified, the server is
+//! SIGKILLed and restarted. Afterwards every window of every machine has exactly one result in
 //! ROTORID_IDENT, byte for byte the JSON of an offline `identify` of the same samples
 //! (cut here from the simulation, not from the frames), and ROTORID_LATEST holds each
 //! machine's last window.
@@ -34,6 +36,28 @@ async fn ident_count(fleet: &Fleet) -> u64 {
     }
 }
 
+/// Whether ROTORID_IDENT holds the result of `window` of `machine`.
+async fn has_result(fleet: &Fleet, machine: &str, window: u64) -> bool {
+    let Ok(mut stream) = fleet.js.get_stream(IDENT_STREAM).await else {
+        return false;
+    };
+    let Ok(info) = stream.info().await else {
+        return false;
+    };
+    for seq in info.state.first_sequence..=info.state.last_sequence {
+        let Ok(m) = stream.direct_get(seq).await else {
+            continue;
+        };
+        if m.subject.as_str() != format!("rotorid.ident.{machine}") {
+            continue;
+        }
+        if serde_json::from_slice::<WindowResult>(&m.payload).is_ok_and(|r| r.window == window) {
+            return true;
+        }
+    }
+    false
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
     let tmp = tempfile::tempdir().unwrap();
@@ -58,8 +82,8 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
 
     let method = "modulating";
     let spawn = || spawn_worker(&url, "e2e", method, &scenarios, 3.0);
-    let a = spawn_watched_worker(&url, "e2e", method, &scenarios, 3.0);
-    let b = spawn();
+    // worker a works alone until it holds its third window unacknowledged
+    let mut a = spawn_holding_worker(&url, "e2e", method, &scenarios, 3.0, 3);
 
     let fleet = Fleet::connect(&url, Duration::from_secs(10)).await.unwrap();
     let mut tasks = Vec::new();
@@ -95,16 +119,32 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
             }
         }
     };
-    // kill worker a while it holds a window it has not acknowledged, and start a new one
-    wait_for(total / 4).await;
-    let held = tokio::task::spawn_blocking(move || a.kill_while_holding(Duration::from_secs(60)))
-        .await
-        .unwrap();
+    // kill worker a while it holds a window it has not acknowledged, start a new one and
+    // a second; the held window comes back after the ack wait (3 s) and one of them
+    // identifies it: only then is the server restarted
+    let (a, (held_machine, held_window)) = tokio::task::spawn_blocking(move || {
+        let held = a.wait_until_holding();
+        (a, held)
+    })
+    .await
+    .unwrap();
+    a.kill();
     let a = spawn();
+    let b = spawn();
     eprintln!(
-        "worker killed holding {held} and restarted at {:?}",
+        "worker killed holding window {held_window} of machine {held_machine}, restarted at {:?}",
         started.elapsed()
     );
+    loop {
+        if has_result(&fleet, &held_machine, held_window).await {
+            break;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(240),
+            "window {held_window} of machine {held_machine} was never redelivered"
+        );
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
     wait_for(total / 2).await;
     server.restart();
     eprintln!("server restarted at {:?}", started.elapsed());
@@ -149,7 +189,7 @@ async fn twenty_machines_two_workers_a_kill_and_a_server_restart() {
         .sum();
     assert!(
         redelivered >= 1,
-        "no window was redelivered: the kill tested nothing"
+        "the held window's result came from a redelivery, which the workers count"
     );
 
     // every stored result, by (machine, window)

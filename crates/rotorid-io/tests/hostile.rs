@@ -3,7 +3,6 @@
 //! hang, or allocate beyond the file's size (the fuzz targets in fuzz/ go further).
 
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -60,18 +59,14 @@ fn fixtures() -> Vec<(PathBuf, Format, Vec<u8>)> {
     out
 }
 
-/// Reads, and checks that an error names the file and that the read was quick; true when
-/// the file was refused.
+/// Reads, and checks that an error names the file and that the read allocated no more
+/// than the file allows; true when the file was refused.
 fn read(format: Format, name: &str, bytes: &[u8]) -> bool {
-    let t0 = Instant::now();
+    // (a reader that loops for ever hangs this test, which CI's time limit ends; how fast
+    // a read is depends on the machine's load and is no test's business)
     PEAK.with(|p| p.set(0));
     let r = read_bytes(format, name, bytes);
     let peak = PEAK.with(|p| p.get());
-    assert!(
-        t0.elapsed() < Duration::from_secs(5),
-        "{name}: {:?}",
-        t0.elapsed()
-    );
     let limit = allowed(format, name, bytes.len());
     assert!(
         peak <= limit,

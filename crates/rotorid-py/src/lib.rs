@@ -9,7 +9,9 @@
 //! - [`columns`]: borrowed columns in, the estimates table out.
 //! - [`options`]: the method and its settings from keyword arguments.
 //! - [`stream`]: identification of a record, or of a live stream of chunks.
+//! - [`balance`]: multi-plane balancing and trial planning from the two CSV tables.
 
+pub mod balance;
 pub mod columns;
 pub mod error;
 pub mod options;

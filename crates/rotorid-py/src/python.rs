@@ -16,6 +16,7 @@ use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rotorid::parameter::ModelKind;
 use rotorid::pipeline::DEFAULT_TIME_TOLERANCE;
 use rotorid::scenario_file::SimulationOverrides;
 
@@ -157,16 +158,26 @@ pub struct PyScenario {
 #[pymethods]
 impl PyScenario {
     #[new]
-    #[pyo3(signature = (*, m=None, cx=None, kx=None, cz=None, kz=None, a=None, m_u=None,
+    #[pyo3(signature = (*, model=None, m=None, cx=None, kx=None, cz=None, kz=None, kxx=None,
+        kxz=None, kzx=None, kzz=None, cxx=None, cxz=None, czx=None, czz=None, a=None, m_u=None,
         d=None, alpha_deg=None, rpm=None, rpm0=None, accel=None, phi0_deg=None, dt=None,
         duration=None, x0=None, z0=None, vx0=None, vz0=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
+        model: Option<String>,
         m: Option<f64>,
         cx: Option<f64>,
         kx: Option<f64>,
         cz: Option<f64>,
         kz: Option<f64>,
+        kxx: Option<f64>,
+        kxz: Option<f64>,
+        kzx: Option<f64>,
+        kzz: Option<f64>,
+        cxx: Option<f64>,
+        cxz: Option<f64>,
+        czx: Option<f64>,
+        czz: Option<f64>,
         a: Option<f64>,
         m_u: Option<f64>,
         d: Option<f64>,
@@ -183,11 +194,20 @@ impl PyScenario {
         vz0: Option<f64>,
     ) -> PyResult<Self> {
         let keys = ScenarioKeys {
+            model,
             m,
             cx,
             cz,
             kx,
             kz,
+            kxx,
+            kxz,
+            kzx,
+            kzz,
+            cxx,
+            cxz,
+            czx,
+            czz,
             a,
             m_u,
             d,
@@ -232,10 +252,13 @@ impl PyScenario {
         self.inner.origin()
     }
 
-    /// The keys it states (the keyword arguments of an equal scenario).
+    /// The keys it states, its model first (the keyword arguments of an equal scenario).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let k = self.inner.keys().map_err(py_err)?;
         let d = PyDict::new(py);
+        if let Some(model) = &k.model {
+            d.set_item("model", model)?;
+        }
         for (name, v) in key_values(&k) {
             if let Some(v) = v {
                 d.set_item(name, v)?;
@@ -253,22 +276,40 @@ impl PyScenario {
             return format!("Scenario.from_toml({origin:?})");
         }
         let k = self.inner.keys().unwrap_or_default();
-        let given: Vec<String> = key_values(&k)
+        // the model when it is not the default
+        let model = k
+            .model
+            .as_deref()
+            .filter(|m| *m != ModelKind::Jeffcott.name())
+            .map(|m| format!("model={m:?}"));
+        let given: Vec<String> = model
             .into_iter()
-            .filter_map(|(name, v)| Some(format!("{name}={:?}", v?)))
+            .chain(
+                key_values(&k)
+                    .into_iter()
+                    .filter_map(|(name, v)| Some(format!("{name}={:?}", v?))),
+            )
             .collect();
         format!("Scenario({})", given.join(", "))
     }
 }
 
-/// The keys by keyword name, in the order of `Scenario(...)`'s arguments.
-fn key_values(k: &ScenarioKeys) -> [(&'static str, Option<f64>); 19] {
+/// The numeric keys by keyword name, in the order of `Scenario(...)`'s arguments.
+fn key_values(k: &ScenarioKeys) -> [(&'static str, Option<f64>); 27] {
     [
         ("m", k.m),
         ("cx", k.cx),
         ("kx", k.kx),
         ("cz", k.cz),
         ("kz", k.kz),
+        ("kxx", k.kxx),
+        ("kxz", k.kxz),
+        ("kzx", k.kzx),
+        ("kzz", k.kzz),
+        ("cxx", k.cxx),
+        ("cxz", k.cxz),
+        ("czx", k.czx),
+        ("czz", k.czz),
         ("a", k.a),
         ("m_u", k.m_u),
         ("d", k.d),
@@ -618,6 +659,62 @@ impl PySession {
     }
 }
 
+/// Multi-plane balancing (`rotorid.balance`) or, with `plan`, trial planning
+/// (`rotorid.plan_trials`): `balance.json` as text, from the CSV texts of the vectors and
+/// the masses (crate::balance).
+#[pyfunction]
+#[pyo3(signature = (vectors, masses, current, *, vectors_name="vectors", masses_name="masses",
+    method="ls", speeds=None, planes=None, limits=Vec::new(), weights=Vec::new(),
+    radius=Vec::new(), default_radius=None, holes_equal=Vec::new(), holes_angles=Vec::new(),
+    mass_set=None, per_hole=1, phase=None, unit=None, plan=None))]
+#[allow(clippy::too_many_arguments)]
+fn balance(
+    py: Python<'_>,
+    vectors: String,
+    masses: String,
+    current: String,
+    vectors_name: &str,
+    masses_name: &str,
+    method: &str,
+    speeds: Option<Vec<f64>>,
+    planes: Option<Vec<String>>,
+    limits: Vec<(String, f64)>,
+    weights: Vec<(String, f64)>,
+    radius: Vec<(String, f64)>,
+    default_radius: Option<f64>,
+    holes_equal: Vec<(String, (usize, f64))>,
+    holes_angles: Vec<(String, Vec<f64>)>,
+    mass_set: Option<Vec<f64>>,
+    per_hole: usize,
+    phase: Option<String>,
+    unit: Option<String>,
+    plan: Option<f64>,
+) -> PyResult<String> {
+    let r = crate::balance::Request {
+        vectors: (vectors_name.to_owned(), vectors),
+        masses: (masses_name.to_owned(), masses),
+        current,
+        method: method.to_owned(),
+        speeds,
+        planes,
+        limits,
+        weights,
+        radius,
+        default_radius,
+        holes_equal,
+        holes_angles,
+        mass_set,
+        per_hole,
+        phase,
+        unit,
+    };
+    py.detach(|| match plan {
+        Some(fraction) => crate::balance::plan_json(&r, fraction),
+        None => crate::balance::balance_json(&r),
+    })
+    .map_err(py_err)
+}
+
 /// The extension module.
 #[pymodule]
 #[pyo3(name = "_rotorid")]
@@ -629,8 +726,10 @@ fn rotorid_extension(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_blocks, m)?)?;
     m.add_class::<PyBlocks>()?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;
+    m.add_function(wrap_pyfunction!(balance, m)?)?;
     m.add("METHODS", options::METHOD_NAMES.to_vec())?;
     m.add("UNKNOWNS", options::UNKNOWN_NAMES.to_vec())?;
+    m.add("MODELS", options::MODEL_NAMES.to_vec())?;
     m.add("ESTIMATE_COLUMNS", ESTIMATE_COLUMNS.to_vec())?;
     Ok(())
 }

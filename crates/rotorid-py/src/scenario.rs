@@ -8,6 +8,7 @@ use std::fmt::Write as _;
 use std::io::Read as _;
 
 use rotorid::model::rad_per_s_to_rpm;
+use rotorid::parameter::ModelKind;
 use rotorid::pipeline::Knowledge;
 use rotorid::scenario_file::{
     ScenarioFileError, ScenarioSpec, SimulationOverrides, BUILTIN_TABLE1,
@@ -24,17 +25,28 @@ pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
 pub const KEYWORDS_ORIGIN: &str = "Scenario()";
 
 /// The keys of a scenario file, each optional (the file's units: `alpha_deg` and
-/// `phi0_deg` in degrees, `rpm` and `rpm0` in rev/min, the rest SI). `rpm` makes the speed
-/// constant; `rpm0` and `accel` make it a ramp. `x0`, `z0`, `vx0`, `vz0` are `[initial]`'s
-/// `x`, `z`, `vx`, `vz`.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+/// `phi0_deg` in degrees, `rpm` and `rpm0` in rev/min, the rest SI). `model` is
+/// `rotor.model` (`"jeffcott"`, the default, with cx, cz, kx, kz; `"cross_coupled"` with
+/// kxx, kxz, kzx, kzz \[N/m\] and cxx, cxz, czx, czz \[N s/m\]; a key of the other model
+/// is the library's error). `rpm` makes the speed constant; `rpm0` and `accel` make it a
+/// ramp. `x0`, `z0`, `vx0`, `vz0` are `[initial]`'s `x`, `z`, `vx`, `vz`.
+#[derive(Debug, Clone, Default, PartialEq)]
 #[allow(missing_docs)]
 pub struct ScenarioKeys {
+    pub model: Option<String>,
     pub m: Option<f64>,
     pub cx: Option<f64>,
     pub cz: Option<f64>,
     pub kx: Option<f64>,
     pub kz: Option<f64>,
+    pub kxx: Option<f64>,
+    pub kxz: Option<f64>,
+    pub kzx: Option<f64>,
+    pub kzz: Option<f64>,
+    pub cxx: Option<f64>,
+    pub cxz: Option<f64>,
+    pub czx: Option<f64>,
+    pub czz: Option<f64>,
     pub a: Option<f64>,
     pub m_u: Option<f64>,
     pub d: Option<f64>,
@@ -60,6 +72,14 @@ impl ScenarioKeys {
             ("cz", self.cz),
             ("kx", self.kx),
             ("kz", self.kz),
+            ("kxx", self.kxx),
+            ("kxz", self.kxz),
+            ("kzx", self.kzx),
+            ("kzz", self.kzz),
+            ("cxx", self.cxx),
+            ("cxz", self.cxz),
+            ("czx", self.czx),
+            ("czz", self.czz),
             ("a", self.a),
             ("m_u", self.m_u),
             ("d", self.d),
@@ -93,10 +113,14 @@ impl ScenarioKeys {
             ("initial", &initial[..]),
         ] {
             let given: Vec<_> = keys.iter().filter_map(|(k, v)| Some((k, (*v)?))).collect();
-            if given.is_empty() && !(section == "speed" && kind.is_some()) {
+            let model = self.model.as_deref().filter(|_| section == "rotor");
+            if given.is_empty() && !(section == "speed" && kind.is_some()) && model.is_none() {
                 continue;
             }
             writeln!(text, "[{section}]").expect("writing to a String");
+            if let Some(model) = model {
+                writeln!(text, "model = {}", toml_string(model)).expect("writing to a String");
+            }
             if section == "speed" {
                 if let Some(kind) = kind {
                     writeln!(text, "kind = \"{kind}\"").expect("writing to a String");
@@ -108,6 +132,25 @@ impl ScenarioKeys {
         }
         text
     }
+}
+
+/// `s` as a TOML basic string that reads back identically (any text: the library then
+/// names it if it is not a model).
+fn toml_string(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if c.is_control() => {
+                write!(out, "\\u{:04X}", u32::from(c)).expect("writing to a String")
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
 }
 
 /// `v` as a TOML number that reads back identically.
@@ -216,16 +259,14 @@ impl Scenario {
         self.spec.simulation(ov).map_err(|e| self.error(e))
     }
 
-    /// The keys it states, in the file's units (a round trip through
+    /// The keys it states, in the file's units, with its model (a round trip through
     /// [`Scenario::from_keys`] gives the same scenario up to the rounding of rpm).
     pub fn keys(&self) -> Result<ScenarioKeys, Error> {
         let v = self.spec.identification().map_err(|e| self.error(e))?;
+        let t = v.truth;
         let mut k = ScenarioKeys {
-            m: v.truth.m,
-            cx: v.truth.cx,
-            cz: v.truth.cz,
-            kx: v.truth.kx,
-            kz: v.truth.kz,
+            model: Some(v.model.name().to_owned()),
+            m: t.m,
             a: Some(v.a),
             m_u: Some(v.m_u),
             d: Some(v.d),
@@ -234,6 +275,13 @@ impl Scenario {
             duration: v.sampling.map(|s| s.duration()),
             ..ScenarioKeys::default()
         };
+        match v.model {
+            ModelKind::Jeffcott => (k.cx, k.cz, k.kx, k.kz) = (t.cx, t.cz, t.kx, t.kz),
+            ModelKind::CrossCoupled => {
+                (k.cxx, k.czz, k.kxx, k.kzz) = (t.cx, t.cz, t.kx, t.kz);
+                (k.cxz, k.czx, k.kxz, k.kzx) = (t.cxz, t.czx, t.kxz, t.kzx);
+            }
+        }
         match v.speed {
             Some(SpeedProfile::Constant { omega, phi0 }) => {
                 k.rpm = Some(rad_per_s_to_rpm(omega));
@@ -281,7 +329,9 @@ fn without_line(mut e: ScenarioFileError) -> Error {
         | E::UnknownSpeedKind { line, .. }
         | E::SpeedKeyNotApplicable { line, .. }
         | E::MissingSpeedKind { line, .. }
-        | E::MissingSpeedKey { line, .. } => *line = None,
+        | E::MissingSpeedKey { line, .. }
+        | E::DampingNotDissipative { line, .. }
+        | E::UnknownModel { line, .. } => *line = None,
         _ => {}
     }
     e.into()
@@ -375,6 +425,117 @@ mod tests {
         };
         let s = Scenario::from_keys(&partial).unwrap();
         assert!(s.knowledge().unwrap_err().to_string().contains("rotor.a"));
+    }
+
+    fn cross_keys() -> ScenarioKeys {
+        ScenarioKeys {
+            model: Some("cross_coupled".into()),
+            m: Some(14.29),
+            kxx: Some(1.195e6),
+            kxz: Some(-3e4),
+            kzx: Some(3e4),
+            kzz: Some(1.4e6),
+            cxx: Some(200.0),
+            cxz: Some(20.0),
+            czx: Some(-20.0),
+            czz: Some(200.0),
+            a: Some(2.871),
+            m_u: Some(1e-4),
+            d: Some(0.15),
+            alpha_deg: Some(45.0),
+            rpm: Some(1200.0),
+            dt: Some(1e-4),
+            duration: Some(1.0),
+            ..ScenarioKeys::default()
+        }
+    }
+
+    #[test]
+    fn cross_coupled_keywords_give_the_scenario_of_the_same_file() {
+        let file = "[rotor]\nmodel = \"cross_coupled\"\nm = 14.29\nkxx = 1.195e6\nkxz = -3e4\n\
+                    kzx = 3e4\nkzz = 1.4e6\ncxx = 200\ncxz = 20\nczx = -20\nczz = 200\n\
+                    a = 2.871\nm_u = 1e-4\nd = 0.15\nalpha_deg = 45\n[speed]\nkind = \"constant\"\n\
+                    rpm = 1200\n[sampling]\ndt = 1e-4\nduration = 1.0\n";
+        let ov = SimulationOverrides::default();
+        let from_file = Scenario::from_toml("cross.toml", file).unwrap();
+        let s = Scenario::from_keys(&cross_keys()).unwrap();
+        assert_eq!(
+            s.simulation(&ov).unwrap(),
+            from_file.simulation(&ov).unwrap()
+        );
+        let rotor = s.simulation(&ov).unwrap().rotor;
+        assert_eq!(rotor.model(), ModelKind::CrossCoupled);
+        let c = rotor.params().coupling.unwrap();
+        assert_eq!((c.kxz, c.kzx, c.cxz, c.czx), (-3e4, 3e4, 20.0, -20.0));
+        // the keys read back, under the model's names
+        let k = from_file.keys().unwrap();
+        assert_eq!(k.model.as_deref(), Some("cross_coupled"));
+        assert_eq!(
+            (k.kxx, k.kxz, k.czx, k.czz),
+            (Some(1.195e6), Some(-3e4), Some(-20.0), Some(200.0))
+        );
+        assert_eq!((k.kx, k.cx), (None, None));
+        let again = Scenario::from_keys(&k).unwrap();
+        assert_eq!(again.simulation(&ov).unwrap().rotor, rotor);
+        assert_eq!(
+            Scenario::table1().keys().unwrap().model.as_deref(),
+            Some("jeffcott")
+        );
+    }
+
+    #[test]
+    fn cross_coupled_keyword_errors_are_the_librarys_without_a_line() {
+        // the damping matrix's symmetric part is not positive semi-definite
+        let bad = ScenarioKeys {
+            cxz: Some(500.0),
+            czx: Some(500.0),
+            ..cross_keys()
+        };
+        let e = Scenario::from_keys(&bad).unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "Scenario(): rotor: the damping matrix [[cxx, cxz], [czx, czz]] = \
+                           [[200, 500], [500, 200]] N s/m is not dissipative"
+            ),
+            "{e}"
+        );
+        // a Jeffcott key in the cross-coupled model, and a cross-coupled key without it
+        let mixed = ScenarioKeys {
+            kx: Some(1e6),
+            ..cross_keys()
+        };
+        let e = Scenario::from_keys(&mixed).unwrap_err().to_string();
+        assert!(e.starts_with("Scenario(): unknown key rotor.kx;"), "{e}");
+        assert!(
+            e.ends_with("(kx is a key of rotor.model = \"jeffcott\")"),
+            "{e}"
+        );
+        let e = Scenario::from_keys(&ScenarioKeys {
+            model: None,
+            ..cross_keys()
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("(kxx is a key of rotor.model = \"cross_coupled\")"),
+            "{e}"
+        );
+        // any text reaches the library intact, and its message names it
+        for name in ["crosscoupled", "a\"b\\c\n"] {
+            let e = Scenario::from_keys(&ScenarioKeys {
+                model: Some(name.into()),
+                ..ScenarioKeys::default()
+            })
+            .unwrap_err()
+            .to_string();
+            assert_eq!(
+                e,
+                format!(
+                    "Scenario(): rotor.model = \"{name}\" is not a rotor model: must be \
+                     \"jeffcott\" or \"cross_coupled\""
+                )
+            );
+        }
     }
 
     #[test]

@@ -21,7 +21,7 @@ def test_scenarios_three_ways(tmp_path, table1):
     f.write_text("[rotor]\na = 2.871\nm_u = 1e-4\nd = 0.15\nalpha_deg = 45\n[speed]\nkind = \"constant\"\nrpm = 1200\n")
     rig = rotorid.Scenario.from_toml(f)
     assert rig.origin == str(f)
-    assert rig.to_dict() == {"a": 2.871, "m_u": 1e-4, "d": 0.15, "alpha_deg": 45.0,
+    assert rig.to_dict() == {"model": "jeffcott", "a": 2.871, "m_u": 1e-4, "d": 0.15, "alpha_deg": 45.0,
                              "rpm": pytest.approx(1200), "phi0_deg": 0.0}
     assert rotorid.Scenario.load("table1").to_dict() == keys
     assert repr(table1) == "Scenario.table1()"
@@ -65,7 +65,7 @@ def test_repr_html_and_plot(noisy, clean, table1):
     res = rotorid.identify(noisy, table1, method="refine")
     html = res._repr_html_()
     assert "<table>" in html and "<td>kx</td>" in html and "N s/m" in html
-    assert repr(res).startswith("<rotorid.Identification method=refine samples=10001>")
+    assert repr(res).startswith("<rotorid.Identification method=refine samples=10001 model=jeffcott>")
     fig = res.plot()
     assert fig.axes and fig.axes[0].get_ylabel() == "relative to truth"
     fig = rotorid.identify(clean, table1, method="algebraic").plot()
@@ -108,3 +108,25 @@ def test_restart_gives_windows_and_is_refused_for_other_methods():
     assert d["restart_s"] == 0.05 and d["windows"] == 9
     with pytest.raises(ValueError, match="restart applies to method algebraic only"):
         rotorid.identify(df, sc, method="modulating", restart=0.05)
+
+
+def test_rounded_stamps_are_a_note_and_jitter_is_refused():
+    """Stamps printed with 6 decimals at 25.6 kHz (as pandas reads such a CSV) identify with
+    the true period and a note, not a warning; 2 % jitter printed alike is refused, as by
+    the CLI."""
+    sc = rotorid.Scenario.table1()
+    df = rotorid.simulate(sc, dt=1 / 25600, duration=0.3, snr_db=40, seed=3)
+    rounded = df.copy()
+    rounded["t"] = rounded["t"].round(6)
+    res = rotorid.identify(rounded, sc, method="modulating")
+    assert len(res.notes) == 1 and "printed to 1e-6 s" in res.notes[0], res.notes
+    assert all("printed to" not in w for w in res.warnings)
+    assert abs(res.to_dict()["record"]["dt_s"] * 25600 - 1) < 1e-8
+    exact = rotorid.identify(df, sc, method="modulating")
+    assert exact.notes == []
+    rng = np.random.default_rng(1)
+    n = len(df)
+    jittered = df.copy()
+    jittered["t"] = (np.arange(n) / 25600 + 0.02 / 25600 * rng.standard_normal(n)).round(6)
+    with pytest.raises(ValueError, match="sampling is not uniform"):
+        rotorid.identify(jittered, sc, method="modulating")

@@ -35,7 +35,8 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     let spec = ScenarioSpec::load(&args.scenario)?;
     let columns = args.columns.as_deref();
     let (name, input) = if let Some(acq) = spec.acquisition() {
-        // a raw acquisition: conditioned in two passes, then identified
+        // a raw acquisition: conditioned and identified until the rotor guess settles,
+        // then identified as any record
         let table = tables::read(&args.input)?;
         let raw = tables::raw_record(&table, acq)?;
         let slow = tables::slow_roll(&spec, acq)?;
@@ -45,7 +46,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
             slow.as_ref(),
             &spec,
             &spec.knowledge()?,
-            Some(&method),
+            Some((&method, args.time_tolerance)),
         )?;
         tables::print_report(&c);
         let cols = tables::conditioned_columns(c);

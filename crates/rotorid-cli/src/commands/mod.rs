@@ -3,10 +3,12 @@
 pub mod analyze;
 pub mod balance;
 pub mod condition;
+pub mod dashboard;
 pub mod demo;
 pub mod fleet;
 pub mod identify;
 pub mod inspect;
+pub mod onex;
 pub mod paper;
 pub mod plot;
 pub mod publish;

@@ -67,6 +67,9 @@ fn read_recording(file: &str) -> anyhow::Result<(TimeGrid, Vec<Channel>)> {
     };
     let grid = TimeGrid::fit(&cols.t, DEFAULT_TIME_TOLERANCE)
         .with_context(|| format!("{file}: column t"))?;
+    if let Some(note) = grid.rounding_note() {
+        eprintln!("note: {file}: {note}");
+    }
     let mut channels = vec![("x", "m", cols.x), ("z", "m", cols.z)];
     if let Some([phi, w, wd]) = cols.speed {
         channels.extend([

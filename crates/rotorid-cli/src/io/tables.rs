@@ -7,9 +7,10 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use rotorid::acquisition::{
-    condition, Acquisition, Conditioned, GuessSource, ModelGuess, RawRecord, TimeBase,
+    condition, condition_iterated, Acquisition, Conditioned, GuessSource, ModelGuess, RawRecord,
+    TimeBase,
 };
-use rotorid::pipeline::{identify, Knowledge, Method, Record};
+use rotorid::pipeline::{Knowledge, Method};
 use rotorid::scenario_file::ScenarioSpec;
 use rotorid_io::units::{conversion, Quantity};
 use rotorid_io::{select, ColumnMap, Format, SiBlocks, SiColumns, Table};
@@ -152,48 +153,53 @@ pub fn slow_roll(spec: &ScenarioSpec, acq: &Acquisition) -> anyhow::Result<Optio
     Ok(Some(raw_record(&table, acq)?))
 }
 
-/// The scenario's rotor as a guess for the conditioning, when it states m, cx, kx, cz, kz.
-pub fn scenario_guess(spec: &ScenarioSpec) -> Option<ModelGuess> {
-    let sc = spec
-        .simulation(&Default::default())
-        .ok()
-        .filter(|_| spec.knowledge().is_ok_and(|k| k.truth.is_some()))?;
-    Some(ModelGuess {
-        rotor: sc.rotor.params(),
-        initial: None,
-        source: GuessSource::Scenario,
-    })
+/// The scenario's rotor as a guess for the conditioning, when its `[rotor]` is complete
+/// (whatever else the scenario lacks: a raw record's has no `[speed]`), else why not.
+pub fn scenario_guess(spec: &ScenarioSpec) -> Result<ModelGuess, String> {
+    spec.rotor("the conditioning's rotor guess")
+        .map(|r| ModelGuess {
+            rotor: r.params(),
+            initial: None,
+            source: GuessSource::Scenario,
+        })
+        .map_err(|e| e.to_string())
 }
 
-/// Condition `raw` for `acq`; with `method`, in two passes (docs/acquisition.md): the first
-/// conditioned record is identified, and its estimate is the rotor guess of the second.
+/// Condition `raw` for `acq` with the scenario's rotor (when its `[rotor]` is complete;
+/// the notes say which rotor, or why none); with `method`, iterated with the
+/// identification until the guess settles (`rotorid::acquisition::condition_iterated`,
+/// docs/acquisition.md section 6), the estimates checked against their grid within
+/// `time_tolerance` dt.
 pub fn condition_for(
     raw: &RawRecord,
     acq: &Acquisition,
     slow: Option<&RawRecord>,
     spec: &ScenarioSpec,
     knowledge: &Knowledge,
-    method: Option<&Method>,
+    method: Option<(&Method, f64)>,
 ) -> anyhow::Result<Conditioned> {
-    let first = condition(raw, acq, slow, scenario_guess(spec).as_ref())?;
-    let Some(method) = method else {
-        return Ok(first);
-    };
-    let rec = Record::from_response(&first.response())?;
-    let id = identify(&rec, knowledge, method)?;
-    match ModelGuess::from_identification(&id, knowledge) {
-        Some(g) => Ok(condition(raw, acq, slow, Some(&g))?),
-        None => {
-            let mut first = first;
-            first.report.notes.push(
-                "the first pass's estimates do not make a rotor the model accepts (m, kx, kz \
-                 > 0) and the scenario has no nominal values to stand in: the record stays \
-                 conditioned without that guess"
-                    .into(),
-            );
-            Ok(first)
+    let first = scenario_guess(spec);
+    let mut c = match method {
+        None => condition(raw, acq, slow, first.as_ref().ok())?,
+        Some((method, time_tolerance)) => {
+            condition_iterated(
+                raw,
+                acq,
+                slow,
+                first.as_ref().ok(),
+                knowledge,
+                method,
+                time_tolerance,
+            )?
+            .conditioned
         }
+    };
+    if let Err(why) = first {
+        c.report
+            .notes
+            .insert(0, format!("no rotor guess from the scenario: {why}"));
     }
+    Ok(c)
 }
 
 /// `c` as the columns of a record (SI already).

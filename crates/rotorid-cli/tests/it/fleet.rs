@@ -94,7 +94,7 @@ fn a_recording_published_in_windows_is_identified_by_a_worker() {
             break s;
         }
         assert!(
-            t.elapsed() < Duration::from_secs(120),
+            t.elapsed() < Duration::from_secs(300), // against a hang, not a speed test
             "not identified:\n{s}"
         );
         std::thread::sleep(Duration::from_millis(200));

@@ -3,7 +3,10 @@
 mod common;
 
 mod analysis;
+mod balance;
 mod daqmx;
+mod dashboard;
+mod dashboard_browser;
 mod demo;
 mod fleet;
 mod formats;
@@ -12,6 +15,7 @@ mod identify;
 mod modulating;
 mod paper;
 mod plot;
+mod raw_records;
 mod refine;
 mod safety;
 mod scenario;

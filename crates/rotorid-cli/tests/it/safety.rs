@@ -645,8 +645,21 @@ fn a_full_disk_leaves_whole_rows_or_nothing_and_names_the_output() {
 
 // ---------------------------------------------------------------- signals
 
-/// Start a long `simulate` to a file in a fresh directory, send `sig` once it has run a
-/// while, and return the directory's content after it died.
+/// Whether process `pid` has a file in `dir` open (through /proc/PID/fd: an unnamed
+/// O_TMPFILE shows as `DIR/#INODE (deleted)`) with data in it.
+fn writing_into(pid: u32, dir: &Path) -> bool {
+    let Ok(fds) = std::fs::read_dir(format!("/proc/{pid}/fd")) else {
+        return false;
+    };
+    let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    fds.flatten().any(|fd| {
+        let into = std::fs::read_link(fd.path()).is_ok_and(|t| t.starts_with(&dir));
+        into && std::fs::metadata(fd.path()).is_ok_and(|m| m.len() > 0)
+    })
+}
+
+/// Start a long `simulate` to a file in a fresh directory, send `sig` once it is writing
+/// its output, and return the directory's content after it died.
 #[expect(
     clippy::zombie_processes,
     reason = "reaped by wait4, which also gives the peak"
@@ -682,15 +695,21 @@ fn interrupted(sig: i32, named_temporary: bool) -> (Measured, Vec<String>) {
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
+    // Signal it once it provably holds its temporary output open and has written to it
+    // (a file descriptor of the child into the directory, of non-zero size), named or
+    // not: a signal before that would leave nothing whatever the code does, and test
+    // nothing. The deadline only keeps a broken build from hanging the test.
     let start = Instant::now();
-    if named_temporary {
-        // wait until the hidden temporary is there
-        while names(dir.path()).is_empty() && start.elapsed() < Duration::from_secs(20) {
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        assert_eq!(names(dir.path()).len(), 1, "no temporary file appeared");
+    while !writing_into(child.id(), dir.path()) {
+        assert!(
+            start.elapsed() < Duration::from_secs(300),
+            "the simulation never opened its output"
+        );
+        std::thread::sleep(Duration::from_millis(10));
     }
-    std::thread::sleep(Duration::from_millis(300));
+    if named_temporary {
+        assert_eq!(names(dir.path()).len(), 1, "the named temporary is there");
+    }
     // SAFETY: a signal to our own child.
     unsafe { libc::kill(child.id() as i32, sig) };
     let (status, peak_kib) = wait4(child.id());

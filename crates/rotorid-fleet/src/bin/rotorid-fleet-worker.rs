@@ -5,6 +5,9 @@
 //!
 //! METHOD is `algebraic`, `modulating` or `refine`; SCENARIOS_DIR holds `<ID>.toml`.
 //! Exits 0 after SIGINT/SIGTERM, printing `windows=N errors=N alerts=N redelivered=N`.
+//! `ROTORID_FLEET_VERBOSE` (set): a line per window taken and done on stderr;
+//! `ROTORID_FLEET_HOLD_AFTER=N`: hold the N-th window taken unacknowledged until killed
+//! (`WorkerConfig::hold_after`).
 
 use std::time::Duration;
 
@@ -35,6 +38,15 @@ fn main() {
     cfg.durable = a[1].clone();
     cfg.ack_wait = Duration::from_secs_f64(ack_wait);
     cfg.verbose = std::env::var_os("ROTORID_FLEET_VERBOSE").is_some();
+    if let Some(v) = std::env::var_os("ROTORID_FLEET_HOLD_AFTER") {
+        match v.to_str().and_then(|v| v.parse::<u64>().ok()) {
+            Some(n) if n >= 1 => cfg.hold_after = Some(n),
+            _ => {
+                eprintln!("ROTORID_FLEET_HOLD_AFTER = {v:?} is not a count of windows >= 1");
+                std::process::exit(2);
+            }
+        }
+    }
     let rt = match tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
         .enable_all()

@@ -13,6 +13,10 @@ use rotorid_fleet::Channel;
 
 pub use rotorid_fleet::test_server::Server;
 
+/// Rotors eq. (1) does not describe, from the library's adequacy tests.
+#[path = "../../../rotorid/tests/it/defects.rs"]
+pub mod defects;
+
 /// Machine `i`'s rotor: table1 with kx, kz, cx, cz varied by a few per cent.
 pub fn rotor(i: usize) -> RotorParams {
     let p = Rotor::table1().params();
@@ -127,109 +131,61 @@ pub fn spawn_worker(url: &str, durable: &str, method: &str, dir: &Path, ack_wait
     Worker(Some(child))
 }
 
-/// A verbose worker (`ROTORID_FLEET_VERBOSE`) whose stderr the test reads, to know which
-/// window it holds.
-pub struct Watched {
+/// A worker that holds the `n`-th window it takes unacknowledged until it is killed
+/// (`ROTORID_FLEET_HOLD_AFTER`, `WorkerConfig::hold_after`); the test reads its stderr to
+/// learn which window.
+pub struct Holding {
     worker: Worker,
-    /// Bytes of stderr read so far that do not yet end a line.
-    partial: Vec<u8>,
-    /// The last window it took and has not reported done (so not acknowledged).
-    holding: Option<String>,
 }
 
-pub fn spawn_watched_worker(
+pub fn spawn_holding_worker(
     url: &str,
     durable: &str,
     method: &str,
     dir: &Path,
     ack_wait_s: f64,
-) -> Watched {
+    n: u64,
+) -> Holding {
     let child = worker_command(url, durable, method, dir, ack_wait_s)
-        .env("ROTORID_FLEET_VERBOSE", "1")
+        .env("ROTORID_FLEET_HOLD_AFTER", n.to_string())
         .stderr(Stdio::piped())
         .spawn()
         .expect("the worker starts");
-    {
-        use std::os::fd::AsRawFd as _;
-        let fd = child.stderr.as_ref().expect("piped").as_raw_fd();
-        // SAFETY: fcntl on a pipe descriptor this process owns
-        let ok = unsafe { libc::fcntl(fd, libc::F_SETFL, libc::O_NONBLOCK) };
-        assert_eq!(ok, 0, "stderr pipe made non-blocking");
-    }
-    Watched {
+    Holding {
         worker: Worker(Some(child)),
-        partial: Vec::new(),
-        holding: None,
     }
 }
 
-impl Watched {
-    /// Read what the worker has written on stderr so far (all of it, once it is stopped).
-    fn drain(&mut self) {
-        use std::io::Read as _;
+impl Holding {
+    /// Block until the worker says it holds its window, and return (machine, window); a
+    /// worker that exits first fails the test with what it wrote.
+    pub fn wait_until_holding(&mut self) -> (String, u64) {
+        use std::io::BufRead as _;
         let child = self.worker.0.as_mut().expect("a running worker");
-        let err = child.stderr.as_mut().expect("piped");
-        let mut buf = [0u8; 4096];
-        loop {
-            match err.read(&mut buf) {
-                Ok(0) => break,
-                Ok(n) => self.partial.extend_from_slice(&buf[..n]),
-                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => break,
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                Err(e) => panic!("reading the worker's stderr: {e}"),
+        let err = std::io::BufReader::new(child.stderr.as_mut().expect("piped"));
+        let mut seen = Vec::new();
+        for line in err.lines() {
+            let line = line.expect("the worker's stderr");
+            // "holding window W of machine M (delivery D)"
+            if let Some(rest) = line.strip_prefix("holding window ") {
+                let mut w = rest.split_whitespace();
+                let window = w.next().and_then(|v| v.parse().ok());
+                let machine = w.nth(2).map(str::to_owned);
+                if let (Some(window), Some(machine)) = (window, machine) {
+                    return (machine, window);
+                }
             }
+            seen.push(line);
         }
-        while let Some(end) = self.partial.iter().position(|&b| b == b'\n') {
-            let line: Vec<u8> = self.partial.drain(..=end).collect();
-            let line = String::from_utf8_lossy(&line);
-            let what = line.split(" (stream").next().unwrap_or("").to_owned();
-            if line.trim_end().ends_with(" taken") {
-                self.holding = Some(what);
-            } else if line.trim_end().ends_with(" done") {
-                self.holding = None;
-            }
-        }
+        panic!(
+            "the worker ended before it held a window: {}",
+            seen.join("\n")
+        );
     }
 
-    /// SIGKILL the worker at a moment it holds a window it has not acknowledged (so the
-    /// server must redeliver it), and return that window. Stops the worker (SIGSTOP), reads
-    /// everything it wrote, and either kills it or lets it go on (SIGCONT) and tries again.
-    /// A partly written "done" line still means "not acknowledged": the ack follows it.
-    pub fn kill_while_holding(mut self, within: std::time::Duration) -> String {
-        let start = std::time::Instant::now();
-        loop {
-            let pid = self.worker.0.as_ref().expect("a running worker").id() as i32;
-            // SAFETY: signals to our own child, which is not reaped yet
-            unsafe { libc::kill(pid, libc::SIGSTOP) };
-            // wait until it is stopped (WNOWAIT: an exit stays for the final wait)
-            let mut info: libc::siginfo_t = unsafe { std::mem::zeroed() };
-            // SAFETY: waitid on our own child, info is a valid out pointer
-            let r = unsafe {
-                libc::waitid(
-                    libc::P_PID,
-                    pid as libc::id_t,
-                    &mut info,
-                    libc::WSTOPPED | libc::WEXITED | libc::WNOWAIT,
-                )
-            };
-            assert_eq!(r, 0, "waiting for the worker to stop");
-            assert_eq!(
-                info.si_code,
-                libc::CLD_STOPPED,
-                "the worker ended before it could be killed holding a window"
-            );
-            self.drain();
-            if let Some(w) = self.holding.take() {
-                self.worker.kill();
-                return w;
-            }
-            unsafe { libc::kill(pid, libc::SIGCONT) };
-            assert!(
-                start.elapsed() < within,
-                "the worker never held an unacknowledged window in {within:?}"
-            );
-            std::thread::sleep(std::time::Duration::from_millis(7));
-        }
+    /// SIGKILL it (it holds its window unacknowledged) and reap it.
+    pub fn kill(mut self) {
+        self.worker.kill();
     }
 }
 

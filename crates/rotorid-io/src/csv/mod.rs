@@ -4,6 +4,7 @@
 //!
 //! - [`columns`]: header names (trimmed, lower-cased, a unit suffix split off), the search
 //!   for required columns, one field parsed as a number;
+//! - [`balance`]: `vectors.csv` and `masses.csv` of influence-coefficient balancing;
 //! - [`lines`]: line numbers as an editor counts them (LF, CRLF and CR alike) and a cap on
 //!   a line's length, so a file that is not line-based text cannot exhaust memory;
 //! - [`error`]: [`CsvError`], `FILE line L, column C (NAME): message`;
@@ -12,6 +13,7 @@
 //! - [`decimal`]: the fast path for plain decimals in front of fast-float2 (the same values,
 //!   bit for bit).
 
+pub mod balance;
 pub mod columns;
 pub mod decimal;
 pub mod error;
@@ -21,6 +23,7 @@ pub mod records;
 pub mod response;
 pub mod table;
 
+pub use balance::{read_masses, read_vectors, MassRow, Phase, VectorRow};
 pub use error::{CsvError, WriteFailure};
 pub use response::{ResponseReader, ResponseRow, Speed, RESPONSE_HEADER};
 pub use table::read_csv_table;

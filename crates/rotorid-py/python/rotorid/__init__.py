@@ -1,23 +1,37 @@
-"""rotorid: identify the physical parameters of a 2-DOF Jeffcott rotor from vibration.
+"""rotorid: identify the physical parameters of a 2-DOF rotor from vibration.
 
-The model (the paper's eq. (1), SI units throughout)::
+Two models (``docs/method.md`` sections 1.2 and 1.6, SI units throughout). The paper's
+Jeffcott rotor, eq. (1)::
 
     m x'' + cx x' - a w z' - a w' z + kx x = m_u d (w^2 sin(phi+alpha) - w' cos(phi+alpha))
     m z'' + cz z' + a w x'          + kz z = m_u d (w' sin(phi+alpha) + w^2 cos(phi+alpha))
 
-with x horizontal and z vertical displacement [m], phi the rotor angle [rad],
-w = phi' [rad/s], m [kg], c [N s/m], k [N/m], a [N s^2/m], m_u d [kg m], alpha [rad].
+and the same disk on cross-coupled bearings (``model="cross_coupled"``), whose stiffness and
+damping are full 2x2 matrices::
+
+    m x'' + cxx x' + cxz z' - a w z' + kxx x + kxz z - a w' z = Fx
+    m z'' + czx x' + czz z' + a w x' + kzx x + kzz z          = Fz
+
+with x horizontal and z vertical displacement [m], phi the rotor angle [rad] (the shaft
+turns from +z towards +x), w = phi' [rad/s], m [kg], c [N s/m], k [N/m] (kxz: the restoring
+force in x per unit displacement in z), a [N s^2/m], m_u d [kg m], alpha [rad].
 
 Quick start::
 
     import rotorid
     sc = rotorid.Scenario.table1()
     df = rotorid.simulate(sc, snr_db=40, seed=1)      # t, x, z, phi, phi_dot, phi_ddot
-    res = rotorid.identify(df, sc, method="refine")
+    res = rotorid.identify(df, sc, method="refine")    # model="cross_coupled" or "auto"
     res.params                                         # value, std_error, crb, unit, ...
 
 Every computation runs in the Rust library with the GIL released; a record gives the
 same result (``res.to_dict()``) as ``rotorid identify --summary`` on the same file.
+
+Balancing (influence coefficients of many planes, sensors and speeds)::
+
+    b = rotorid.balance(vectors_df, masses_df, current="asfound", holes={"disk1": 12})
+    b.corrections                                      # mass_kg, angle_deg and their std
+    b.residual, b.influence, b.split                   # DataFrames; b.to_dict() == balance.json
 """
 
 from __future__ import annotations
@@ -29,17 +43,23 @@ import numpy as np
 import pandas as pd
 
 from . import _rotorid
-from ._rotorid import ESTIMATE_COLUMNS, METHODS, UNKNOWNS, Scenario
+from ._rotorid import ESTIMATE_COLUMNS, METHODS, MODELS, UNKNOWNS, Scenario
+from ._balance import Balance, TrialPlan, balance, plan_trials
 from ._result import Identification
 
 __all__ = [
     "ESTIMATE_COLUMNS",
     "METHODS",
+    "MODELS",
     "UNKNOWNS",
+    "Balance",
     "Identification",
     "Scenario",
     "Session",
+    "TrialPlan",
+    "balance",
     "identify",
+    "plan_trials",
     "read",
     "read_blocks",
     "simulate",
@@ -206,6 +226,7 @@ def identify(
     method: str = "refine",
     unknowns: Sequence[str] | None = None,
     *,
+    model: str | None = None,
     quadrature: str | None = None,
     rcond_min: float | None = None,
     tol: float | None = None,
@@ -224,12 +245,19 @@ def identify(
             in place; other dtypes and layouts are converted.
         sc: what is known besides the record: a, m_u, d, alpha_deg (and the truth m, c, k
             when stated, for errors and the Cramer-Rao bound); ``"table1"`` or a TOML path
-            are loaded.
+            are loaded. Its model (``rotor.model``) is the default model.
         method: ``"algebraic"`` (an estimate per sample), ``"modulating"`` (least squares
             over windows) or ``"refine"`` (maximum likelihood with standard errors and the
             Cramer-Rao bound).
-        unknowns: refine: what to estimate among m, cx, kx, cz, kz, a, unbalance
-            (default m, cx, kx, cz, kz); the others are known from the scenario.
+        unknowns: refine: what to estimate among m, the model's coefficients (Jeffcott:
+            cx, kx, cz, kz; cross-coupled: cxx, cxz, czx, czz, kxx, kxz, kzx, kzz), a,
+            unbalance (default m and the model's coefficients); the others are known from
+            the scenario.
+        model: ``"jeffcott"``, ``"cross_coupled"`` (overrides the scenario's ``rotor.model``,
+            as the CLI's ``--model``) or, with method refine, ``"auto"``: both are fitted
+            and the simplest whose residuals pass the adequacy test is taken by BIC
+            (``res.model``, ``res.model_selection``, ``res.notes``). Default: the
+            scenario's.
         quadrature: algebraic (and refine's start): trapezoid, am3, am4, am5 (default am5).
         rcond_min: conditioning threshold in [0, 1] (default 1e-5 algebraic, 1e-8 modulating).
         tol: algebraic: relative band of the identification time (default 0.01).
@@ -237,7 +265,10 @@ def identify(
             (every estimate from a window between half and one period old; default: one
             identifier over the whole record).
         window: modulating and refine: window of the modulating identifier [s] (default 0.02).
-        time_tolerance: allowed deviation of a stamp from the uniform grid, relative to dt.
+        time_tolerance: allowed deviation of a stamp from the uniform grid fitted by least
+            squares over the stamps, relative to that dt; stamps whose values have few
+            decimals (printed to 6 decimals at 25.6 kHz) may besides be off by one unit of
+            their last decimal (at most dt/4): accepted, with a note (``notes``).
         input, scenario: the names written into the summary (``to_dict()``), as the CLI
             writes its input path and ``--scenario`` argument; default None.
 
@@ -245,14 +276,15 @@ def identify(
         The :class:`Identification`.
 
     Raises:
-        ValueError: a bad option (naming it and its allowed range), a column that is not
-            1-D or holds NaN or infinity (naming it and the sample index), non-uniform
-            sampling, or a scenario that lacks what the method needs.
+        ValueError: a bad option (naming it and its allowed range; ``model="auto"`` with
+            another method than refine), a column that is not 1-D or holds NaN or
+            infinity (naming it and the sample index), non-uniform sampling, or a
+            scenario that lacks what the method needs.
     """
     cols = _columns(data)
     summary, estimates, seconds = _rotorid.identify(
         _scenario(sc), method, cols["t"], cols["x"], cols["z"],
-        cols["phi"], cols["phi_dot"], cols["phi_ddot"],
+        cols["phi"], cols["phi_dot"], cols["phi_ddot"], model=model,
         unknowns=None if unknowns is None else list(unknowns),
         quadrature=quadrature, rcond_min=rcond_min, tol=tol, window=window,
         restart=restart, time_tolerance=time_tolerance, input=input, scenario_name=scenario,
@@ -271,7 +303,7 @@ class Session:
             checked against t0 + i dt). ``None``: the grid is fitted over the first 4096
             stamps, held back until then (or until :meth:`start_now`), as the CLI does.
         t0: time of the first sample [s] when ``dt`` is given.
-        Other keyword arguments: as :func:`identify`.
+        Other keyword arguments (``model``, ``unknowns``, ...): as :func:`identify`.
 
     Example::
 
@@ -287,6 +319,7 @@ class Session:
         dt: float | None = None,
         t0: float = 0.0,
         *,
+        model: str | None = None,
         unknowns: Sequence[str] | None = None,
         quadrature: str | None = None,
         rcond_min: float | None = None,
@@ -296,7 +329,7 @@ class Session:
         time_tolerance: float = 1e-6,
     ) -> None:
         self._inner = _rotorid.Session(
-            _scenario(sc), method, dt, t0,
+            _scenario(sc), method, dt, t0, model=model,
             unknowns=None if unknowns is None else list(unknowns),
             quadrature=quadrature, rcond_min=rcond_min, tol=tol, window=window,
             restart=restart, time_tolerance=time_tolerance,

@@ -6,16 +6,25 @@ from typing import Any, Iterator, Mapping, Sequence, final
 import numpy as np
 import pandas as pd
 
+from ._balance import Balance as Balance
+from ._balance import TrialPlan as TrialPlan
+from ._balance import balance as balance
+from ._balance import plan_trials as plan_trials
 from ._result import Identification as Identification
 
 __all__ = [
     "ESTIMATE_COLUMNS",
     "METHODS",
+    "MODELS",
     "UNKNOWNS",
+    "Balance",
     "Identification",
     "Scenario",
     "Session",
+    "TrialPlan",
+    "balance",
     "identify",
+    "plan_trials",
     "read",
     "read_blocks",
     "simulate",
@@ -23,25 +32,38 @@ __all__ = [
 
 __version__: str
 METHODS: list[str]
+MODELS: list[str]
 UNKNOWNS: list[str]
 ESTIMATE_COLUMNS: list[str]
 
 @final
 class Scenario:
     """A scenario: the built-in table1, a TOML file, or the file's keys as keyword
-    arguments: m [kg], cx, cz [N s/m], kx, kz [N/m], a [N s^2/m], m_u [kg], d [m],
-    alpha_deg [deg]; rpm [rev/min] (constant speed) or rpm0 [rev/min] and accel
-    [rad/s^2] (ramp), phi0_deg [deg]; dt, duration [s]; x0, z0 [m], vx0, vz0 [m/s].
-    Out-of-range values raise ValueError naming the key and its allowed range."""
+    arguments: model (``"jeffcott"``, the default, or ``"cross_coupled"``), m [kg]; the
+    Jeffcott model's cx, cz [N s/m], kx, kz [N/m] or the cross-coupled model's kxx, kxz,
+    kzx, kzz [N/m], cxx, cxz, czx, czz [N s/m]; a [N s^2/m], m_u [kg], d [m], alpha_deg
+    [deg]; rpm [rev/min] (constant speed) or rpm0 [rev/min] and accel [rad/s^2] (ramp),
+    phi0_deg [deg]; dt, duration [s]; x0, z0 [m], vx0, vz0 [m/s]. Out-of-range values (a
+    damping matrix that is not dissipative, a key of the other model) raise ValueError
+    naming the key and its allowed range."""
 
     def __new__(
         cls,
         *,
+        model: str | None = None,
         m: float | None = None,
         cx: float | None = None,
         kx: float | None = None,
         cz: float | None = None,
         kz: float | None = None,
+        kxx: float | None = None,
+        kxz: float | None = None,
+        kzx: float | None = None,
+        kzz: float | None = None,
+        cxx: float | None = None,
+        cxz: float | None = None,
+        czx: float | None = None,
+        czz: float | None = None,
         a: float | None = None,
         m_u: float | None = None,
         d: float | None = None,
@@ -69,8 +91,8 @@ class Scenario:
     @property
     def origin(self) -> str:
         """``table1``, the file's path, or ``Scenario()``."""
-    def to_dict(self) -> dict[str, float]:
-        """The keys it states (keyword arguments of an equal scenario)."""
+    def to_dict(self) -> dict[str, float | str]:
+        """The keys it states, ``model`` first (keyword arguments of an equal scenario)."""
 
 def simulate(
     sc: Scenario | str,
@@ -101,6 +123,7 @@ def identify(
     method: str = "refine",
     unknowns: Sequence[str] | None = None,
     *,
+    model: str | None = None,
     quadrature: str | None = None,
     rcond_min: float | None = None,
     tol: float | None = None,
@@ -122,6 +145,7 @@ class Session:
         dt: float | None = None,
         t0: float = 0.0,
         *,
+        model: str | None = None,
         unknowns: Sequence[str] | None = None,
         quadrature: str | None = None,
         rcond_min: float | None = None,

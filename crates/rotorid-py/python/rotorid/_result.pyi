@@ -16,10 +16,20 @@ class Identification:
     @property
     def method(self) -> str: ...
     @property
+    def model(self) -> str:
+        """``jeffcott`` or ``cross_coupled``."""
+    @property
+    def model_selection(self) -> pd.DataFrame | None:
+        """Index model; columns estimated, log_likelihood, bic, adequate, noise_ratio_x,
+        noise_ratio_z, converged, identifiable, chosen; None when the model was given."""
+    @property
     def params(self) -> pd.DataFrame:
-        """Index parameter; columns value, std_error, crb, unit, truth, rel_error."""
+        """Index parameter (the model's names); columns value, std_error, crb, unit,
+        truth, rel_error."""
     @property
     def warnings(self) -> list[str]: ...
+    @property
+    def notes(self) -> list[str]: ...
     @property
     def estimates(self) -> pd.DataFrame:
         """t [s], m_x, c_x, k_x, m_z, c_z, k_z, rcond_x, rcond_z, window."""
@@ -28,6 +38,8 @@ class Identification:
     def to_dict(self) -> dict[str, Any]: ...
     def to_json(self, **kwargs: Any) -> str: ...
     def to_ross_bearing_kwargs(self) -> dict[str, float]:
-        """{"kxx": kx, "kyy": kz, "cxx": cx, "cyy": cz} [N/m, N s/m]."""
+        """ROSS's BearingElement coefficients [N/m, N s/m] (ROSS's y is rotorid's -z):
+        Jeffcott {"kxx": kx, "kyy": kz, "cxx": cx, "cyy": cz}; cross-coupled also
+        kxy = -kxz, kyx = -kzx, cxy = -cxz, cyx = -czx."""
     def _repr_html_(self) -> str: ...
     def plot(self, ax: Any = None) -> Any: ...

@@ -6,9 +6,10 @@ import numpy as np
 
 from . import Scenario as Scenario
 
-__all__ = ["ESTIMATE_COLUMNS", "METHODS", "UNKNOWNS", "Blocks", "Scenario", "Session", "identify", "read", "read_blocks", "simulate"]
+__all__ = ["ESTIMATE_COLUMNS", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "read", "read_blocks", "simulate"]
 
 METHODS: list[str]
+MODELS: list[str]
 UNKNOWNS: list[str]
 ESTIMATE_COLUMNS: list[str]
 
@@ -43,6 +44,7 @@ def identify(
     phi_dot: Any = None,
     phi_ddot: Any = None,
     *,
+    model: str | None = None,
     unknowns: list[str] | None = None,
     quadrature: str | None = None,
     rcond_min: float | None = None,
@@ -55,6 +57,30 @@ def identify(
 ) -> tuple[str, dict[str, np.ndarray], float]:
     """(summary JSON, estimates columns, seconds spent in the library)."""
 
+def balance(
+    vectors: str,
+    masses: str,
+    current: str,
+    *,
+    vectors_name: str = "vectors",
+    masses_name: str = "masses",
+    method: str = "ls",
+    speeds: list[float] | None = None,
+    planes: list[str] | None = None,
+    limits: list[tuple[str, float]] = ...,
+    weights: list[tuple[str, float]] = ...,
+    radius: list[tuple[str, float]] = ...,
+    default_radius: float | None = None,
+    holes_equal: list[tuple[str, tuple[int, float]]] = ...,
+    holes_angles: list[tuple[str, list[float]]] = ...,
+    mass_set: list[float] | None = None,
+    per_hole: int = 1,
+    phase: str | None = None,
+    unit: str | None = None,
+    plan: float | None = None,
+) -> str:
+    """balance.json (or, with plan=fraction, the trial plan) as JSON text."""
+
 @final
 class Session:
     def __new__(
@@ -64,6 +90,7 @@ class Session:
         dt: float | None = None,
         t0: float = 0.0,
         *,
+        model: str | None = None,
         unknowns: list[str] | None = None,
         quadrature: str | None = None,
         rcond_min: float | None = None,

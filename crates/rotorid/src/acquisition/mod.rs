@@ -23,14 +23,17 @@
 //!    transient's mean put into the DC and measures what is left locked to phi (1X-3X),
 //!    reported as [`AcquisitionFinding::ResidualRunout`] when significant.
 //!
-//! Identification iterates: condition with the scenario's rotor (or none), identify,
-//! condition again with [`ModelGuess::from_identification`] (the estimate and the fitted
-//! initial state), identify again. Two passes suffice (docs/acquisition.md section 6).
+//! Identification iterates ([`condition_iterated`], module `iterate`): condition with the
+//! scenario's complete `[rotor]` (or none), identify, condition again with
+//! [`ModelGuess::from_identification`] (the estimate and the fitted initial state),
+//! identify again, until the estimates move by less than a tenth of their standard errors
+//! (docs/acquisition.md section 6).
 //!
 //! Pure computation: no file I/O. The caller reads the raw record and the slow-roll file
 //! (whose path `[acquisition.runout] slow_roll` names) into [`RawRecord`]s.
 
 mod error;
+mod iterate;
 pub mod keyphasor;
 pub mod model_fit;
 pub mod probes;
@@ -40,6 +43,10 @@ pub mod runout;
 use serde::Serialize;
 
 pub use error::{AcquisitionError, Which};
+pub use iterate::{
+    change, condition_iterated, ChangeBasis, Iterated, IterationError, Passes, MAX_PASSES,
+    SETTLED_RELATIVE, SETTLED_STD_ERRORS,
+};
 pub use keyphasor::{shaft_angle, KeyphasorReport, ShaftAngle};
 pub use model_fit::ModelFit;
 pub use raw::{simulate_raw, RawSettings, RawSimulation, RunoutHarmonic};
@@ -359,6 +366,19 @@ pub enum AcquisitionFinding {
         /// The significant components.
         components: Vec<LockedComponent>,
     },
+    /// The iterated conditioning (`condition_iterated`) stopped at its last pass with the
+    /// rotor guess still moving: the runout and DC corrections may still bias m, c, k.
+    NotSettled {
+        /// Passes made.
+        passes: usize,
+        /// The largest change of an estimate in the last pass, in its standard errors (or
+        /// relative, when `relative`).
+        last_change: f64,
+        /// The estimate that changed most.
+        parameter: Option<String>,
+        /// Whether `last_change` is relative (the method gives no standard errors).
+        relative: bool,
+    },
     /// The keyphasor needed repairs.
     KeyphasorRepaired {
         /// Events after which pulses were missing \[s\].
@@ -399,6 +419,27 @@ impl AcquisitionFinding {
                     )
                 }
             }
+            Self::NotSettled {
+                passes,
+                last_change,
+                parameter,
+                relative,
+            } => format!(
+                "the conditioning did not settle in {passes} passes: in the last, {} still moved \
+                 by {last_change:.2e} {} (the limit is {:e}); the runout and DC corrections \
+                 that depend on the rotor guess may bias m, c, k by about that much",
+                parameter.as_deref().unwrap_or("an estimate"),
+                if *relative {
+                    "of its value"
+                } else {
+                    "standard errors"
+                },
+                if *relative {
+                    SETTLED_RELATIVE
+                } else {
+                    SETTLED_STD_ERRORS
+                }
+            ),
             Self::KeyphasorRepaired {
                 missed_before_s,
                 spurious_s,
@@ -472,6 +513,9 @@ pub struct ConditionReport {
     pub findings: Vec<AcquisitionFinding>,
     /// What was assumed, in words.
     pub notes: Vec<String>,
+    /// The passes of the iterated conditioning ([`condition_iterated`]); `None` for one
+    /// conditioning ([`condition`]).
+    pub passes: Option<Passes>,
 }
 
 /// The conditioned record.
@@ -591,6 +635,20 @@ pub fn time_of(
     }
 }
 
+/// The times the keyphasor is timed on: the uniform grid fitted over the stamps `t` when
+/// they are rounded (printed with few decimals: off that grid by more than the default
+/// time tolerance, within their rounding; `pipeline::TimeGrid::fit`), with that grid; else
+/// the stamps. Rounded stamps put each event up to half a unit of their last decimal off
+/// (0.5 us with 6 decimals, 3e-5 rad at 650 rpm), the same way on every record: on a
+/// 600 rpm + 10 rad/s^2 run-up that biased m and k by 1.4 Cramer-Rao bounds (measured,
+/// docs/acquisition.md section 9).
+fn keyphasor_times(t: Vec<f64>) -> (Vec<f64>, Option<crate::pipeline::TimeGrid>) {
+    match crate::pipeline::TimeGrid::fit(&t, crate::pipeline::DEFAULT_TIME_TOLERANCE) {
+        Ok(g) if g.rounded => ((0..t.len()).map(|i| g.time(i)).collect(), Some(g)),
+        _ => (t, None),
+    }
+}
+
 /// The probe voltages and keyphasor of `raw`, checked against its time stamps.
 fn channels<'a>(
     raw: &'a RawRecord,
@@ -626,6 +684,7 @@ fn slow_roll_runout(
     let which = Which::SlowRoll;
     let t = time_of(slow, acq, which)?;
     let (v, kp) = channels(slow, acq, &t, which)?;
+    let (t, _) = keyphasor_times(t);
     let sa = shaft_angle(&t, kp, &acq.keyphasor, which)?;
     let range = whole_revolutions(&t, &sa.report);
     let angles = [acq.probes[0].angle, acq.probes[1].angle];
@@ -685,14 +744,22 @@ pub fn condition(
 ) -> Result<Conditioned, AcquisitionError> {
     acq.validate()?;
     let which = Which::Running;
-    let t = time_of(raw, acq, which)?;
-    let (v, kp) = channels(raw, acq, &t, which)?;
+    let stamps = time_of(raw, acq, which)?;
+    let (v, kp) = channels(raw, acq, &stamps, which)?;
     let angles = [acq.probes[0].angle, acq.probes[1].angle];
     let inv = probes::inverse_projection(angles)?;
+    let (t, rounded) = keyphasor_times(stamps.clone());
     let sa = shaft_angle(&t, kp, &acq.keyphasor, which)?;
     let n = t.len();
     let range = whole_revolutions(&t, &sa.report);
     let mut notes = Vec::new();
+    if let Some(g) = rounded {
+        notes.push(format!(
+            "the time stamps are printed to {:e} s (up to {:.2e} s off the uniform grid fitted \
+             over them): the keyphasor is timed on that grid, dt = {:e} s (the stamps are kept)",
+            g.resolution, g.max_deviation, g.dt
+        ));
+    }
     let mut findings = Vec::new();
     if !sa.report.missed_pulses_before_s.is_empty() || !sa.report.spurious_pulses_s.is_empty() {
         findings.push(AcquisitionFinding::KeyphasorRepaired {
@@ -731,6 +798,21 @@ pub fn condition(
     let mut dc_corr = dc;
     let model = match guess {
         Some(g) => {
+            let r = &g.rotor;
+            notes.push(format!(
+                "rotor guess ({}): m = {} kg, cx = {} N s/m, kx = {} N/m, cz = {} N s/m, \
+                 kz = {} N/m",
+                match g.source {
+                    GuessSource::Scenario => "the scenario's [rotor]",
+                    GuessSource::Identification => "the previous pass's estimate",
+                    GuessSource::Given => "given",
+                },
+                r.m,
+                r.cx,
+                r.kx,
+                r.cz,
+                r.kz
+            ));
             let fit = model_fit::fit(
                 &g.rotor,
                 g.initial,
@@ -820,9 +902,10 @@ pub fn condition(
         model,
         findings,
         notes,
+        passes: None,
     };
     Ok(Conditioned {
-        t,
+        t: stamps,
         x,
         z,
         phi: sa.phi,

@@ -13,6 +13,9 @@ pub enum AnalysisError {
     /// allowed range (this includes NaN and infinity).
     #[error(transparent)]
     OutOfRange(#[from] OutOfRange),
+    /// An input of balancing that cannot be used (a run, sensor, plane, speed or option).
+    #[error(transparent)]
+    Balance(#[from] super::balance::BalanceError),
     /// A covariance names a parameter the analysis does not know.
     #[error("unknown parameter {name:?} in the covariance: expected names from {allowed}")]
     UnknownParameter {

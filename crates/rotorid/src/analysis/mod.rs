@@ -30,8 +30,9 @@
 //!   deviation, and the stability margin (least damped mode) at an operating speed.
 //! - `response`: [`unbalance_response`] (amplitude, phase lag per probe) with standard
 //!   deviations.
-//! - `balance`: correction from the identified unbalance, and single-plane influence
-//!   coefficients from two runs.
+//! - [`balance`]: correction from the identified unbalance; influence-coefficient
+//!   balancing of many planes, sensors and speeds (least squares or min-max), with the
+//!   corrections' uncertainty, their split into holes and trial-weight planning.
 //! - `one_x`: the 1X vector of a sampled signal against the shaft angle.
 //! - `covariance`: [`ParameterCovariance`] and the delta method.
 //!
@@ -51,7 +52,7 @@
 //! # Ok::<(), rotorid::analysis::AnalysisError>(())
 //! ```
 
-mod balance;
+pub mod balance;
 mod covariance;
 mod critical;
 mod error;
@@ -61,14 +62,14 @@ mod response;
 mod stability;
 
 pub use balance::{
-    balance_from_runs, balance_from_unbalance, response_per_unbalance, Correction,
+    balance_from_runs, balance_from_unbalance, response_per_unbalance, BalanceError, Correction,
     InfluenceBalance, ModelBalance, RunVectors, TrialMass,
 };
 pub use covariance::{CovarianceParameter, ParameterCovariance, PARAMETER_NAMES};
 pub use critical::{critical_speeds, CriticalSpeed};
 pub use error::AnalysisError;
 pub use modes::{campbell, modes, Campbell, Mode, Whirl, PLANAR_WHIRL};
-pub use one_x::{one_x, OneX};
+pub use one_x::{one_x, synchronous_average, OneX};
 pub use response::{unbalance_response, Probe, ResponseChannel, ResponseVector, UnbalanceResponse};
 pub use stability::{
     stability, stability_margin, stability_with_covariance, Stability, StabilityMargin,

@@ -6,6 +6,16 @@ use super::error::InputError;
 /// Relative jitter allowed on the sampling period (plus 8 ulp of t).
 pub const SAMPLING_TOLERANCE: f64 = 1e-6;
 
+/// The names of a record's columns beside t, in the order [`record_columns_dt`] takes
+/// their lengths.
+const COLUMNS: [&str; 5] = ["x", "z", "phi", "phi_dot", "phi_ddot"];
+
+/// [`record_dt`] for a record of t and the columns x, z, phi, phi_dot, phi_ddot of
+/// lengths `lens`.
+pub(crate) fn record_columns_dt(t: &[f64], lens: [usize; 5]) -> Result<f64, InputError> {
+    record_dt(t, std::array::from_fn(|i| (COLUMNS[i], lens[i])))
+}
+
 /// The sampling period `t[1] - t[0]` \[s\] of a record with times `t` and the other
 /// `columns` (name, length), after checking that every column is as long as `t`
 /// ([`InputError::ColumnLength`] for the first that is not) and that there are at least

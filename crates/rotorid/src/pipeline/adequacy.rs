@@ -17,10 +17,27 @@
 //! [`NOISE_RATIO_MAX`], unless its residuals are below [`RESIDUAL_FLOOR`] of the signal
 //! (the model's numerical accuracy). Then the refinement's standard errors (which assume white residuals
 //! of a correct model) do not hold, and the pipeline withholds its values.
+//!
+//! The modulating and algebraic identifiers ask the same question of their own model
+//! ([`judge`], docs/method.md section 6.4): eq. (1) refitted by maximum likelihood from
+//! their estimate ([`of_model`]), its residuals through the same tests. Not the response of
+//! their estimate itself: the modulating estimate is within its standard errors but far
+//! less precise than the data in the natural frequencies, which fix the phase of the free
+//! response over the record, so its own residuals fail the tests on correct models (table1
+//! at 40 dB: Ljung-Box p down to 1e-40); the refit's verdict is the model's.
 
 use serde::{Deserialize, Serialize};
 
 use crate::identify::modulating::noise_estimate::DifferenceNoise;
+use crate::model::{InitialState, RotorParams};
+use crate::refine::{model_response, refine, Discretisation, RefineOptions};
+
+use super::diagnostic::{Diagnostic, Direction, Finding};
+use super::error::PipelineError;
+use super::identification::Identification;
+use super::knowledge::Knowledge;
+use super::record::Record;
+use crate::parameter::Parameter;
 
 /// Lags of the Ljung-Box test.
 pub const LJUNG_BOX_LAGS: usize = 20;
@@ -68,6 +85,99 @@ pub struct Adequacy {
     pub x: ChannelAdequacy,
     /// z (vertical).
     pub z: ChannelAdequacy,
+}
+
+impl Adequacy {
+    /// Both channels' figures of `model` (x, z) against the record `rec`.
+    pub(crate) fn of_response(rec: &Record, model_x: &[f64], model_z: &[f64]) -> Self {
+        let dt = rec.grid().dt;
+        let x = channel(rec.x(), model_x, dt);
+        let z = channel(rec.z(), model_z, dt);
+        Self {
+            model_adequate: x.adequate && z.adequate,
+            x,
+            z,
+        }
+    }
+
+    /// One [`Finding::ModelInadequate`] per inadequate channel, x first.
+    pub(crate) fn findings(&self) -> Vec<Diagnostic> {
+        [(Direction::X, &self.x), (Direction::Z, &self.z)]
+            .into_iter()
+            .filter(|(_, c)| !c.adequate)
+            .map(|(direction, c)| {
+                Diagnostic::new(Finding::ModelInadequate {
+                    direction,
+                    ljung_box_p: c.ljung_box_p,
+                    lag1_autocorrelation: c.lag1_autocorrelation,
+                    noise_ratio: c.noise_ratio,
+                    dominant_frequency_hz: c.dominant_frequency_hz,
+                })
+            })
+            .collect()
+    }
+}
+
+/// Step tolerance of the fit [`of_model`] makes, in standard errors: the residual's energy
+/// there is within 0.01 noise variances of the optimum's.
+const REFIT_TOLERANCE: f64 = 0.1;
+
+/// The adequacy of eq. (1) for the record `rec` (module doc): the maximum-likelihood fit
+/// of m, cx, kx, cz, kz and the initial state (a and the unbalance as in `start`) from
+/// `start`, to [`REFIT_TOLERANCE`], its residuals through the tests (as the refinement
+/// tests its own fit, converged or not).
+pub(crate) fn of_model(rec: &Record, start: &RotorParams) -> Result<Adequacy, PipelineError> {
+    let record = rec.for_refine();
+    let options = RefineOptions {
+        tolerance: REFIT_TOLERANCE,
+        ..RefineOptions::default()
+    };
+    let fit = refine(&record, start, &InitialState::default(), &options)?;
+    let model = model_response(
+        &fit.rotor,
+        &fit.initial,
+        &record.experiment(),
+        Discretisation::Auto,
+    )?;
+    Ok(Adequacy::of_response(rec, &model.x, &model.z))
+}
+
+/// Judge the modulating (or algebraic) identification `ident` of `rec` by its own fit
+/// (module doc): when every value is determined, the adequacy of its rotor (m the mean of
+/// m_x and m_z; a and the unbalance from `k`) goes into `ident.adequacy`, and an
+/// inadequate model withholds every value behind one [`Finding::ModelInadequate`] per
+/// channel, first among the diagnostics, as for the refinement. Not judged (`adequacy`
+/// stays `None`) when a value is withheld already or the model response cannot be
+/// computed.
+pub(crate) fn judge(ident: &mut Identification, rec: &Record, k: &Knowledge) {
+    let Some(r) = ident.rotor.as_ref().map(|r| r.params()) else {
+        return;
+    };
+    let value = |p: Parameter| ident.parameter(p).and_then(|v| v.value);
+    // the per-direction model's own free dynamics: each direction's c/m and k/m kept
+    let (mx, mz) = match (value(Parameter::MX), value(Parameter::MZ)) {
+        (Some(mx), Some(mz)) => (mx, mz),
+        _ => (r.m, r.m),
+    };
+    let rotor = RotorParams {
+        cx: r.cx * r.m / mx,
+        kx: r.kx * r.m / mx,
+        cz: r.cz * r.m / mz,
+        kz: r.kz * r.m / mz,
+        a: k.a,
+        unbalance: k.unbalance,
+        ..r
+    };
+    let Ok(a) = of_model(rec, &rotor) else {
+        return;
+    };
+    ident.adequacy = Some(a);
+    if !a.model_adequate {
+        super::withhold_all(ident);
+        for d in a.findings() {
+            ident.diagnostics.insert(0, d);
+        }
+    }
 }
 
 /// The adequacy of `model` for the data `y` sampled every `dt` \[s\].

@@ -196,6 +196,16 @@ pub enum Finding {
         /// Why.
         reason: String,
     },
+    /// Time stamps off the fitted grid by more than the time tolerance, within the
+    /// rounding of the decimals they are printed with (module `grid`): accepted (a note).
+    TimeStampsRounded {
+        /// One unit of the stamps' last decimal \[s\].
+        resolution_s: f64,
+        /// The largest deviation of a stamp from the fitted grid \[s\].
+        max_deviation_s: f64,
+        /// The fitted sampling period \[s\].
+        dt_s: f64,
+    },
     /// `--model auto` chose this model (the summary's `model_selection` has the figures).
     ModelSelected {
         /// The model taken.
@@ -436,6 +446,17 @@ fn message(f: &Finding) -> String {
         Finding::CrbUnavailable { reason } => {
             format!("the Cramer-Rao bound was not computed: {reason}")
         }
+        Finding::TimeStampsRounded {
+            resolution_s,
+            max_deviation_s,
+            dt_s,
+        } => format!(
+            "the time stamps are printed to {resolution_s:e} s: they are up to \
+             {max_deviation_s:.2e} s ({:.3} dt) off the uniform grid fitted over all of them \
+             (dt = {dt_s:e} s), which that rounding explains; the identification uses the \
+             grid",
+            max_deviation_s / dt_s
+        ),
         Finding::ModelSelected { model, reason } => {
             format!("model {model} (chosen by --model auto): {reason}")
         }

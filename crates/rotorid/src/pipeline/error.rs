@@ -49,8 +49,9 @@ pub enum PipelineError {
     #[error(
         "sample {index}: sampling is not uniform: t = {t} s is {deviation:.3e} s off the \
          uniform grid t0 + i dt (dt = {dt} s, fitted over the time stamps); the allowed \
-         deviation is {tolerance:e} of dt. Resample the record, or raise the time tolerance \
-         if the stamps are merely rounded"
+         deviation is {tolerance:e} of dt{}. Resample the record, or raise the time tolerance \
+         if the stamps are merely rounded",
+        rounding_clause(*resolution, *rounding)
     )]
     NonUniformSampling {
         /// Index of the sample.
@@ -63,6 +64,11 @@ pub enum PipelineError {
         dt: f64,
         /// The allowed deviation, relative to dt.
         tolerance: f64,
+        /// The stamps' resolution \[s\] (one unit of their last decimal; 0: none)
+        /// (`TimeGrid::resolution`).
+        resolution: f64,
+        /// The deviation allowed besides for that rounding \[s\] (`rounding_allowance`).
+        rounding: f64,
     },
     /// Fewer samples than the method needs.
     #[error("{samples} sample(s): {method} needs at least {needed} ({why})")]
@@ -137,4 +143,18 @@ pub enum PipelineError {
     /// The refinement refused its input.
     #[error("the refinement cannot run: {0}")]
     Refine(#[from] RefineError),
+}
+
+/// ", plus A s for stamps printed to R s (...)" for the message of
+/// [`PipelineError::NonUniformSampling`]; empty without a resolution.
+fn rounding_clause(resolution: f64, rounding: f64) -> String {
+    if resolution > 0.0 {
+        format!(
+            ", plus {rounding:e} s for stamps printed to {resolution:e} s (their rounding, \
+             at most {} dt)",
+            super::grid::MAX_ROUNDING_ALLOWANCE
+        )
+    } else {
+        String::new()
+    }
 }

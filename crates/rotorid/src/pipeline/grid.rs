@@ -13,6 +13,18 @@
 //! to the first stamp when within [`SNAP_T0`] dt. Exact stamps t_i = i dt thus give dt
 //! itself, bit for bit. [`RunningGrid`] is the same fit updated sample by sample, for
 //! streams.
+//!
+//! Each stamp must lie within `tolerance dt` of the fitted grid, plus the stamps'
+//! rounding: stamps printed with d decimals (25.6 kHz written to 6 decimals, as acquisition
+//! software does) are up to half a unit of the d-th decimal off the grid they were
+//! rounded from, and the least-squares grid of rounded stamps is itself off that grid by
+//! their mean rounding error (at most another half unit; 1/32 of a unit at 25.6 kHz), so
+//! a stamp may be one unit of the stamps' last decimal, [`TimeGrid::resolution`], off the
+//! fitted grid, at most a quarter of dt. The decimals are read from the values, whatever
+//! the file format: the fewest d (up to [`MAX_STAMP_DECIMALS`]) with t 10^d a whole number
+//! to rounding, the most over the stamps ([`stamp_decimals`]). Stamps whose values have
+//! more decimals (computed as i dt, or binary) get no such allowance; jitter, gaps and
+//! non-uniform sampling are refused as before.
 
 use super::error::PipelineError;
 
@@ -21,8 +33,35 @@ use super::error::PipelineError;
 pub const SNAP_DT: f64 = 4.0 * f64::EPSILON;
 /// Distance, relative to dt, within which the fitted t0 is replaced by the first stamp.
 pub const SNAP_T0: f64 = 1e-9;
-/// Default allowed deviation of a stamp from the grid, relative to dt.
+/// Default allowed deviation of a stamp from the grid, relative to dt (besides the
+/// stamps' rounding, module doc).
 pub const DEFAULT_TIME_TOLERANCE: f64 = 1e-6;
+/// Most decimals a stamp's value is read with (module doc): stamps with more count as
+/// exact (no rounding allowance).
+pub const MAX_STAMP_DECIMALS: u32 = 12;
+/// Largest rounding allowance, relative to dt: coarser stamps cannot tell a gap or jitter
+/// from rounding.
+pub const MAX_ROUNDING_ALLOWANCE: f64 = 0.25;
+
+/// 10^d, exact, d = 0 ..= [`MAX_STAMP_DECIMALS`].
+const POW10: [f64; MAX_STAMP_DECIMALS as usize + 1] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12,
+];
+
+/// Whether `s` is a whole number to within 4 ulp, and small enough (|s| < 2^49) for that
+/// to mean something.
+#[inline(always)]
+fn whole(s: f64) -> bool {
+    s.abs() < (1u64 << 49) as f64 && (s - s.round()).abs() <= 4.0 * f64::EPSILON * s.abs()
+}
+
+/// The decimals the stamp `t` \[s\] is printed with, read from its value: the fewest
+/// d <= [`MAX_STAMP_DECIMALS`] with t 10^d a whole number to within rounding (the value a
+/// reader parses from `0.000313` gives 6); `None` when there is none (a stamp computed as
+/// i dt, or a binary one).
+pub fn stamp_decimals(t: f64) -> Option<u32> {
+    (0..=MAX_STAMP_DECIMALS).find(|&d| whole(t * POW10[d as usize]))
+}
 
 /// A uniform time grid t_i = t0 + i dt \[s\], and how well the stamps fit it.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -35,6 +74,15 @@ pub struct TimeGrid {
     pub fitted_over: usize,
     /// Largest |t_i - (t0 + i dt)| over those stamps \[s\].
     pub max_deviation: f64,
+    /// The stamps' resolution \[s\]: one unit of the last decimal they are printed with
+    /// (module doc); 0 when they have more than [`MAX_STAMP_DECIMALS`] (or for a given
+    /// grid).
+    #[serde(default)]
+    pub resolution: f64,
+    /// Whether a stamp needed the rounding allowance: it was more than `tolerance dt` off
+    /// the grid, and within the rounding of its resolution.
+    #[serde(default)]
+    pub rounded: bool,
 }
 
 impl TimeGrid {
@@ -47,11 +95,14 @@ impl TimeGrid {
             dt,
             fitted_over: 0,
             max_deviation: 0.0,
+            resolution: 0.0,
+            rounded: false,
         })
     }
 
     /// The least-squares grid of the stamps `t` (module doc), checked: at least two
-    /// stamps, finite, strictly increasing, each within `tolerance dt` of the grid.
+    /// stamps, finite, strictly increasing, each within `tolerance dt` of the grid (plus
+    /// the rounding of the stamps' resolution).
     pub fn fit(t: &[f64], tolerance: f64) -> Result<Self, PipelineError> {
         check_tolerance(tolerance)?;
         let mut g = RunningGrid::default();
@@ -71,12 +122,19 @@ impl TimeGrid {
                 worst = (d, i);
             }
         }
-        let grid = TimeGrid {
+        let (_, rounded) = grid.check_rounded(worst.1, t[worst.1], tolerance, grid.resolution)?;
+        Ok(TimeGrid {
             max_deviation: worst.0,
+            rounded,
             ..grid
-        };
-        grid.check(worst.1, t[worst.1], tolerance)?;
-        Ok(grid)
+        })
+    }
+
+    /// The note ([`Finding::TimeStampsRounded`](super::Finding::TimeStampsRounded)) of a
+    /// grid whose stamps needed the rounding allowance (module doc), `None` otherwise.
+    pub fn rounding_note(&self) -> Option<super::Diagnostic> {
+        self.rounded
+            .then(|| super::rounded_stamps_note(self.resolution, self.max_deviation, self.dt))
     }
 
     /// t0 + i dt \[s\].
@@ -89,13 +147,35 @@ impl TimeGrid {
     /// `tolerance dt` (plus 8 ulp of t) of t0 + i dt, else the error naming the sample.
     #[inline]
     pub fn check(&self, i: usize, t: f64, tolerance: f64) -> Result<f64, PipelineError> {
-        within(i, t, self.time(i), self.dt, tolerance)
+        within(i, t, self.time(i), self.dt, tolerance, 0.0, 0.0).map(|(d, _)| d)
+    }
+
+    /// [`check`](Self::check) with the rounding allowance of stamps of resolution
+    /// `resolution` \[s\] (module doc): the deviation \[s\], and whether the allowance was
+    /// needed.
+    #[inline]
+    pub fn check_rounded(
+        &self,
+        i: usize,
+        t: f64,
+        tolerance: f64,
+        resolution: f64,
+    ) -> Result<(f64, bool), PipelineError> {
+        // a given grid is the one the stamps were rounded from: half a unit
+        let rounding = if self.fitted_over == 0 {
+            0.5 * rounding_allowance(resolution, self.dt)
+        } else {
+            rounding_allowance(resolution, self.dt)
+        };
+        within(i, t, self.time(i), self.dt, tolerance, resolution, rounding)
     }
 }
 
 /// The deviation |t - expected| \[s\] of stamp `t` of sample `index` when it is within
-/// `tolerance dt` plus 8 ulp of the larger of t and `expected`, else the error naming the
-/// sample: the one test of both [`TimeGrid::check`] and [`RunningGrid::check_newest`].
+/// `tolerance dt` plus 8 ulp of the larger of t and `expected`, plus `rounding` \[s\] for
+/// stamps of resolution `resolution` \[s\] (module doc), else the error naming the
+/// sample; and whether the rounding allowance was needed. The one test of
+/// [`TimeGrid::check`], [`TimeGrid::fit`] and [`RunningGrid::check_newest`].
 #[inline(always)]
 fn within(
     index: usize,
@@ -103,26 +183,53 @@ fn within(
     expected: f64,
     dt: f64,
     tolerance: f64,
-) -> Result<f64, PipelineError> {
+    resolution: f64,
+    rounding: f64,
+) -> Result<(f64, bool), PipelineError> {
     let deviation = (t - expected).abs();
     let allowed = tolerance * dt + 8.0 * f64::EPSILON * t.abs().max(expected.abs());
     if deviation <= allowed {
-        Ok(deviation)
+        Ok((deviation, false))
     } else {
-        Err(off_grid(index, t, deviation, dt, tolerance))
+        rounded(
+            index, t, deviation, allowed, dt, tolerance, resolution, rounding,
+        )
     }
 }
 
-/// The error of stamp `t` of sample `index`, `deviation` \[s\] off a grid of period `dt`.
+/// The stamp beyond `tolerance`: within the rounding allowance, or the error naming it.
 #[cold]
-fn off_grid(index: usize, t: f64, deviation: f64, dt: f64, tolerance: f64) -> PipelineError {
-    PipelineError::NonUniformSampling {
-        index,
-        t,
-        deviation,
-        dt,
-        tolerance,
+#[allow(clippy::too_many_arguments)]
+fn rounded(
+    index: usize,
+    t: f64,
+    deviation: f64,
+    allowed: f64,
+    dt: f64,
+    tolerance: f64,
+    resolution: f64,
+    rounding: f64,
+) -> Result<(f64, bool), PipelineError> {
+    if deviation <= allowed + rounding {
+        Ok((deviation, true))
+    } else {
+        Err(PipelineError::NonUniformSampling {
+            index,
+            t,
+            deviation,
+            dt,
+            tolerance,
+            resolution,
+            rounding,
+        })
     }
+}
+
+/// How far a stamp of resolution `resolution` \[s\] may be off the least-squares grid of
+/// period `dt` by rounding alone (module doc): one unit, at most
+/// [`MAX_ROUNDING_ALLOWANCE`] dt (off a given grid, half that).
+pub fn rounding_allowance(resolution: f64, dt: f64) -> f64 {
+    resolution.min(MAX_ROUNDING_ALLOWANCE * dt)
 }
 
 /// The tolerance must be finite and >= 0.
@@ -146,7 +253,13 @@ pub struct RunningGrid {
     s_u: Compensated,
     /// sum of i u_i (compensated)
     s_iu: Compensated,
+    /// The most decimals of the stamps so far ([`stamp_decimals`]), or
+    /// [`NO_DECIMALS`] when one has more than [`MAX_STAMP_DECIMALS`].
+    decimals: u32,
 }
+
+/// [`RunningGrid`]'s mark of stamps with more decimals than it reads.
+const NO_DECIMALS: u32 = u32::MAX;
 
 /// A sum with Neumaier's compensation: accurate to a few ulps whatever the number of
 /// terms.
@@ -193,6 +306,10 @@ impl RunningGrid {
         if self.n == 0 {
             self.first = t;
         }
+        // one multiplication per stamp while they keep their decimals
+        if self.decimals != NO_DECIMALS && !whole(t * POW10[self.decimals as usize]) {
+            self.decimals = stamp_decimals(t).map_or(NO_DECIMALS, |d| d.max(self.decimals));
+        }
         let u = t - self.first;
         self.s_u.add(u);
         self.s_iu.add(self.n as f64 * u);
@@ -216,6 +333,16 @@ impl RunningGrid {
     /// True before the first stamp.
     pub fn is_empty(&self) -> bool {
         self.n == 0
+    }
+
+    /// The stamps' resolution so far \[s\] ([`TimeGrid::resolution`]): 0 before the first
+    /// stamp and when one has more than [`MAX_STAMP_DECIMALS`] decimals.
+    pub fn resolution(&self) -> f64 {
+        if self.n == 0 || self.decimals == NO_DECIMALS {
+            0.0
+        } else {
+            1.0 / POW10[self.decimals as usize]
+        }
     }
 
     /// The least-squares fit as it stands, not snapped: (t0, dt) \[s\]; cheap enough to
@@ -245,18 +372,31 @@ impl RunningGrid {
             dt,
             fitted_over: self.n,
             max_deviation: 0.0,
+            resolution: self.resolution(),
+            rounded: false,
         })
     }
 
     /// The newest stamp checked against the least-squares fit of every stamp so far
     /// (what a stream checks each stamp against): its deviation |t - (t0 + (n - 1) dt)|
-    /// \[s\] when within `tolerance dt` (plus 8 ulp of t), `None` before two stamps.
+    /// \[s\] when within `tolerance dt` (plus 8 ulp of t, plus the rounding of the stamps'
+    /// resolution so far, module doc), `None` before two stamps.
     /// The fit is [`fit`](Self::fit)'s to rounding, written so that its two divisions do
     /// not wait for each other: `dt = (n S_iu - S_i S_u) / (n^2 (n^2 - 1) / 12)` (the
     /// denominator is n S_ii - S_i^2 in closed form) and, as S_i = n (n - 1) / 2,
     /// `t0 + (n - 1) dt = t_first + S_u / n + dt (n - 1) / 2`.
     #[inline(always)]
     pub fn check_newest(&self, tolerance: f64) -> Result<Option<f64>, PipelineError> {
+        Ok(self.check_newest_rounded(tolerance)?.map(|(d, _)| d))
+    }
+
+    /// [`check_newest`](Self::check_newest), and whether the stamp needed the rounding
+    /// allowance.
+    #[inline(always)]
+    pub fn check_newest_rounded(
+        &self,
+        tolerance: f64,
+    ) -> Result<Option<(f64, bool)>, PipelineError> {
         if self.n < 2 {
             return Ok(None);
         }
@@ -269,7 +409,17 @@ impl RunningGrid {
             return Ok(None);
         }
         let expected = self.first + (s_u / n + dt * ((n - 1.0) * 0.5));
-        within(self.n - 1, self.last, expected, dt, tolerance).map(Some)
+        let resolution = self.resolution();
+        within(
+            self.n - 1,
+            self.last,
+            expected,
+            dt,
+            tolerance,
+            resolution,
+            rounding_allowance(resolution, dt),
+        )
+        .map(Some)
     }
 
     /// The fitted grid (snapped, module doc), `None` before two stamps; `max_deviation`
@@ -291,6 +441,8 @@ impl RunningGrid {
             dt,
             fitted_over: self.n,
             max_deviation: 0.0,
+            resolution: self.resolution(),
+            rounded: false,
         })
     }
 }
@@ -337,14 +489,150 @@ mod tests {
         let t: Vec<f64> = (0..25600)
             .map(|i| (i as f64 * dt * 1e6).round() / 1e6)
             .collect();
-        assert!(TimeGrid::fit(&t, 1e-6).is_err(), "rounding exceeds 1e-6 dt");
-        let g = TimeGrid::fit(&t, 0.02).unwrap();
+        // rounding exceeds 1e-6 dt: without the rounding allowance this is refused
+        let bare = TimeGrid::fit(&t, 0.02).unwrap();
+        assert_eq!((bare.resolution, bare.rounded), (1e-6, false));
+        let g = TimeGrid::fit(&t, 1e-6).unwrap();
+        assert_eq!((g.resolution, g.rounded), (1e-6, true));
+        assert_eq!((g.dt, g.t0), (bare.dt, bare.t0));
+        // the largest deviation from the fitted grid: half a unit and the mean rounding
+        // error (1/32 of a unit here), more than half a unit
+        assert!(g.max_deviation > 0.5e-6, "{}", g.max_deviation);
         // statistically: std = 0.29 us sqrt(12 / n^3) = 2.4e-13 s = 6e-9 dt
         assert!((g.dt - dt).abs() < 5e-8 * dt, "dt {} vs {dt}", g.dt);
         // rounding moves a stamp by <= 0.5 us; the fitted line is not the true one
         assert!(g.max_deviation <= 0.6e-6, "{}", g.max_deviation);
         // the first two stamps would have said 3.9e-5 s, 0.16 % off
         assert!(((t[1] - t[0]) - dt).abs() > 1e-3 * dt);
+    }
+
+    /// Deterministic jitter: a xorshift draw per stamp, uniform in [-1, 1).
+    fn draws(n: usize) -> Vec<f64> {
+        let mut s: u64 = 0x2545_F491_4F6C_DD1D;
+        (0..n)
+            .map(|_| {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+            })
+            .collect()
+    }
+
+    #[test]
+    fn rounded_stamps_are_accepted_and_jitter_gaps_and_rate_changes_are_not() {
+        let dt = 1.0 / 25600.0;
+        let round6 = |t: f64| (t * 1e6).round() / 1e6;
+        let n = 25600;
+        let exact = |i: usize| i as f64 * dt;
+        let check = |t: &[f64]| {
+            let batch = TimeGrid::fit(t, DEFAULT_TIME_TOLERANCE);
+            // the stream: every stamp against the fit of those before it
+            let mut g = RunningGrid::default();
+            let mut stream = Ok(());
+            for (i, &ti) in t.iter().enumerate() {
+                g.push(i, ti).unwrap();
+                if let Err(e) = g.check_newest(DEFAULT_TIME_TOLERANCE) {
+                    stream = Err(e);
+                    break;
+                }
+            }
+            assert_eq!(
+                batch.is_ok(),
+                stream.is_ok(),
+                "batch {batch:?}, stream {stream:?}"
+            );
+            batch
+        };
+        // 6 decimals, and 7 at 102.4 kHz
+        let g = check(&(0..n).map(|i| round6(exact(i))).collect::<Vec<_>>()).unwrap();
+        assert!(g.rounded && g.resolution == 1e-6 && (g.dt - dt).abs() < 1e-8 * dt);
+        let dt7 = 1.0 / 102_400.0;
+        let t7: Vec<f64> = (0..n)
+            .map(|i| (i as f64 * dt7 * 1e7).round() / 1e7)
+            .collect();
+        let g7 = check(&t7).unwrap();
+        assert!(g7.rounded && g7.resolution == 1e-7, "{g7:?}");
+        // exact stamps need no allowance
+        let g0 = check(&(0..n).map(exact).collect::<Vec<_>>()).unwrap();
+        assert!(!g0.rounded && g0.max_deviation < 1e-12);
+        // 2 % jitter, uniform and (nearly) Gaussian, printed with 6 decimals: refused
+        let u = draws(4 * n);
+        let uniform: Vec<f64> = (0..n)
+            .map(|i| round6(exact(i) + 0.02 * dt * u[i]))
+            .collect();
+        let gauss: Vec<f64> = (0..n)
+            .map(|i| {
+                // sum of 3 uniforms, scaled to unit variance
+                let g = (u[n + i] + u[2 * n + i] + u[3 * n + i]) / 1.0;
+                round6(exact(i) + 0.02 * dt * g)
+            })
+            .collect();
+        for (name, t) in [("uniform", uniform), ("gaussian", gauss)] {
+            match check(&t) {
+                Err(PipelineError::NonUniformSampling {
+                    tolerance,
+                    resolution,
+                    ..
+                }) => assert_eq!((tolerance, resolution), (1e-6, 1e-6), "{name}"),
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+        // a missing sample, and a rate that changes half-way
+        let mut gap: Vec<f64> = (0..n).map(|i| round6(exact(i))).collect();
+        gap.remove(n / 2);
+        assert!(check(&gap).is_err());
+        let change: Vec<f64> = (0..n)
+            .map(|i| {
+                round6(if i < n / 2 {
+                    exact(i)
+                } else {
+                    exact(i) * 1.001
+                })
+            })
+            .collect();
+        assert!(check(&change).is_err());
+        // the message says what was allowed
+        let e = check(&gap).unwrap_err().to_string();
+        assert!(
+            e.contains("plus 1e-6 s for stamps printed to 1e-6 s"),
+            "{e}"
+        );
+        // off a given grid, half a unit
+        let given = TimeGrid::given(0.0, dt).unwrap();
+        assert!(given
+            .check_rounded(7, 7.0 * dt + 0.45e-6, 0.0, 1e-6)
+            .is_ok());
+        assert!(given
+            .check_rounded(7, 7.0 * dt + 0.55e-6, 0.0, 1e-6)
+            .is_err());
+    }
+
+    #[test]
+    fn stamp_decimals_are_read_from_the_values() {
+        for (t, d) in [
+            (0.0, Some(0)),
+            (0.000313, Some(6)),
+            (1.5, Some(1)),
+            (12.000001, Some(6)),
+            (3.90625e-5, Some(10)),
+            (1700000000.25, Some(2)),
+            // 3 dt computed (0.00030000000000000003) is 0.0003 to within an ulp: exact
+            // stamps of a decimal dt look printed with dt's decimals, which costs nothing,
+            // as they lie on the grid
+            (3.0 * 1e-4, Some(4)),
+            (1.0 / 3.0, None),
+            (0.123456789012345, None),
+        ] {
+            assert_eq!(stamp_decimals(t), d, "{t}");
+        }
+        let mut g = RunningGrid::default();
+        for (i, t) in [0.0, 0.5, 0.500039, 0.500078].into_iter().enumerate() {
+            g.push(i, t).unwrap();
+        }
+        assert_eq!(g.resolution(), 1e-6);
+        g.push(4, 0.500_117_123_456_789).unwrap();
+        assert_eq!(g.resolution(), 0.0);
     }
 
     /// The stream's check of the newest stamp measures its deviation from the fit, to

@@ -40,7 +40,10 @@ pub use adequacy::{
 pub use consistency::SPEED_FACTOR_TOLERANCE;
 pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};
 pub use error::PipelineError;
-pub use grid::{RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE, SNAP_DT, SNAP_T0};
+pub use grid::{
+    rounding_allowance, stamp_decimals, RunningGrid, TimeGrid, DEFAULT_TIME_TOLERANCE,
+    MAX_ROUNDING_ALLOWANCE, MAX_STAMP_DECIMALS, SNAP_DT, SNAP_T0,
+};
 pub use identification::{
     AlgebraicDetail, Covariance, CrbAt, FinalEstimate, Identification, ModelCandidate,
     ModelSelection, ModulatingDetail, Noise, NoiseSource, ParameterResult, RecordInfo,
@@ -55,8 +58,8 @@ pub use plausibility::{DISPLACEMENT_MAX_M, DISPLACEMENT_MIN_M, NOISE_TO_SIGNAL_M
 pub use record::{rebased, Record, Speed, SpeedSource, CONSTANT_PHI_TOLERANCE};
 pub use refine_run::REFINE_MIN_SAMPLES;
 pub use session::{
-    Sample, SampleEstimate, Session, Timing, ALGEBRAIC_MIN_SAMPLES, DEFAULT_GRID_HEAD,
-    GRID_DRIFT_LIMIT,
+    Sample, SampleEstimate, Session, Timing, ALGEBRAIC_ADEQUACY_SAMPLES, ALGEBRAIC_MIN_SAMPLES,
+    DEFAULT_GRID_HEAD, GRID_DRIFT_LIMIT, MODULATING_CRB_MAX_SAMPLES,
 };
 pub use start::ALGEBRAIC_START_S;
 
@@ -84,8 +87,11 @@ pub fn identify(
     knowledge: &Knowledge,
     method: &Method,
 ) -> Result<Identification, PipelineError> {
+    let rounded = record.grid().rounding_note();
     if let Method::Refine(s) = method {
-        return refine_run::run(record, knowledge, s);
+        let mut ident = refine_run::run(record, knowledge, s)?;
+        ident.diagnostics.extend(rounded);
+        return Ok(ident);
     }
     let profile = match record.speed() {
         Speed::Profile(p) => Some(*p),
@@ -110,12 +116,23 @@ pub fn identify(
         session.push(&s, &mut ignore)?;
     }
     let mut ident = session.finish(&mut ignore)?;
+    ident.diagnostics.extend(rounded);
     ident.record = RecordInfo {
         max_time_deviation_s: record.grid().max_deviation,
         speed: record.speed_source(),
         ..ident.record
     };
     Ok(ident)
+}
+
+/// The note of a record whose stamps were accepted because rounding to `resolution` \[s\]
+/// explains their largest deviation `max_deviation` \[s\] from the grid of period `dt`.
+pub(crate) fn rounded_stamps_note(resolution: f64, max_deviation: f64, dt: f64) -> Diagnostic {
+    Diagnostic::note(Finding::TimeStampsRounded {
+        resolution_s: resolution,
+        max_deviation_s: max_deviation,
+        dt_s: dt,
+    })
 }
 
 /// Withhold every value of `ident` (after a finding that invalidates the input).

@@ -26,7 +26,7 @@ use crate::refine::{
 };
 
 use super::adequacy::Adequacy;
-use super::diagnostic::{Diagnostic, Direction, Directions, Finding};
+use super::diagnostic::{Diagnostic, Directions, Finding};
 use super::error::PipelineError;
 use super::identification::StartSource;
 use super::identification::{
@@ -358,19 +358,8 @@ fn fit(
     };
     let adequacy = adequacy(rec, &fit);
     if let Some(a) = &adequacy {
-        for (direction, c) in [(Direction::X, &a.x), (Direction::Z, &a.z)] {
-            if !c.adequate {
-                diagnostics.insert(
-                    0,
-                    Diagnostic::new(Finding::ModelInadequate {
-                        direction,
-                        ljung_box_p: c.ljung_box_p,
-                        lag1_autocorrelation: c.lag1_autocorrelation,
-                        noise_ratio: c.noise_ratio,
-                        dominant_frequency_hz: c.dominant_frequency_hz,
-                    }),
-                );
-            }
+        for d in a.findings() {
+            diagnostics.insert(0, d);
         }
     }
     diagnostics.extend(super::plausibility::Magnitudes::of(rec.x(), rec.z()).findings());
@@ -482,14 +471,7 @@ fn adequacy(rec: &Record, fit: &Refined) -> Option<Adequacy> {
         Discretisation::Auto,
     )
     .ok()?;
-    let dt = rec.grid().dt;
-    let x = super::adequacy::channel(rec.x(), &model.x, dt);
-    let z = super::adequacy::channel(rec.z(), &model.z, dt);
-    Some(Adequacy {
-        model_adequate: x.adequate && z.adequate,
-        x,
-        z,
-    })
+    Some(Adequacy::of_response(rec, &model.x, &model.z))
 }
 
 /// Signed (value - truth) / truth.

@@ -96,20 +96,31 @@ enum Engine {
         flagged: Directions<u64>,
         last: Option<AlgebraicEstimate>,
         keep: Option<Vec<AlgebraicEstimate>>,
+        /// The first [`ALGEBRAIC_ADEQUACY_SAMPLES`] samples, for the adequacy test.
+        kept: Kept,
     },
     Modulating {
         id: Box<ModulatingIdentifier>,
-        /// The samples, for the Cramer-Rao bound; dropped past [`MODULATING_CRB_MAX_SAMPLES`].
-        kept: Option<Kept>,
+        /// The samples, for the Cramer-Rao bound and the adequacy test; the first
+        /// [`MODULATING_CRB_MAX_SAMPLES`] of a longer record.
+        kept: Kept,
+        /// Whether `kept` holds every sample.
+        complete: bool,
     },
     Refine {
         kept: Kept,
     },
 }
 
-/// Longest record whose samples a modulating session keeps for its Cramer-Rao bound
-/// (5 columns of 8 bytes: 80 MB); longer ones report the bound unavailable.
+/// Longest record whose samples a modulating session keeps for its Cramer-Rao bound and
+/// its adequacy test (5 columns of 8 bytes: 80 MB); longer ones report the bound
+/// unavailable, and their adequacy is tested over their first this many samples.
 pub const MODULATING_CRB_MAX_SAMPLES: usize = 2_000_000;
+
+/// Samples an algebraic session keeps for its adequacy test, which it makes over the
+/// record's first this many samples (5 columns of 8 bytes: 0.66 MB; 1.6 s at 10 kHz): its
+/// memory stays bounded (a streamed identify of any length peaks under 16 MiB).
+pub const ALGEBRAIC_ADEQUACY_SAMPLES: usize = 1 << 14;
 
 /// Samples kept for a computation over the whole record.
 #[derive(Debug, Default)]
@@ -154,6 +165,8 @@ pub struct Session {
     t_first: f64,
     t_last: f64,
     max_deviation: f64,
+    /// Whether a stamp needed the rounding allowance (module `grid`).
+    rounded: bool,
     keep: bool,
     speed_check: super::consistency::SpeedConsistency,
     magnitudes: super::plausibility::Magnitudes,
@@ -213,6 +226,7 @@ impl Session {
             t_first: f64::NAN,
             t_last: f64::NAN,
             max_deviation: 0.0,
+            rounded: false,
             keep: false,
             speed_check: Default::default(),
             magnitudes: Default::default(),
@@ -345,11 +359,14 @@ impl Session {
                 self.running.push(index, t)?;
                 // Check against the given grid, or the fit of every stamp so far.
                 let deviation = match self.timing {
-                    Timing::Grid { grid, .. } => Some(grid.check(index, t, tolerance)?),
-                    Timing::Fit { .. } => self.running.check_newest(tolerance)?,
+                    Timing::Grid { grid, .. } => {
+                        Some(grid.check_rounded(index, t, tolerance, self.running.resolution())?)
+                    }
+                    Timing::Fit { .. } => self.running.check_newest_rounded(tolerance)?,
                 };
-                if let Some(d) = deviation {
+                if let Some((d, rounded)) = deviation {
                     self.max_deviation = self.max_deviation.max(d);
+                    self.rounded |= rounded;
                 }
                 t
             }
@@ -398,11 +415,13 @@ impl Session {
                     flagged: Directions::default(),
                     last: None,
                     keep: self.keep.then(Vec::new),
+                    kept: Kept::default(),
                 }
             }
             Method::Modulating(s) => Engine::Modulating {
                 id: Box::new(ModulatingIdentifier::new(known, grid.dt, s.config)?),
-                kept: Some(Kept::default()),
+                kept: Kept::default(),
+                complete: true,
             },
             Method::Refine(_) => Engine::Refine {
                 kept: Kept::default(),
@@ -448,8 +467,12 @@ impl Session {
                 flagged,
                 last,
                 keep,
+                kept,
             } => {
                 let w = id.push(&m)?;
+                if kept.t.len() < ALGEBRAIC_ADEQUACY_SAMPLES {
+                    kept.push(s.t.unwrap_or(tg), s);
+                }
                 let mut e = w.estimate;
                 e.t = s.t.unwrap_or(tg);
                 tracker.push(&e);
@@ -466,16 +489,12 @@ impl Session {
                     window: w.window,
                 });
             }
-            Engine::Modulating { id, kept } => {
+            Engine::Modulating { id, kept, complete } => {
                 id.push(&m)?;
-                if kept
-                    .as_ref()
-                    .is_some_and(|k| k.t.len() >= MODULATING_CRB_MAX_SAMPLES)
-                {
-                    *kept = None;
-                }
-                if let Some(k) = kept {
-                    k.push(s.t.unwrap_or(tg), s);
+                if kept.t.len() < MODULATING_CRB_MAX_SAMPLES {
+                    kept.push(s.t.unwrap_or(tg), s);
+                } else {
+                    *complete = false;
                 }
             }
             Engine::Refine { kept } => kept.push(s.t.unwrap_or(tg), s),
@@ -511,6 +530,9 @@ impl Session {
             },
         };
         let drift = self.drift(grid);
+        let rounded = self.rounded.then(|| {
+            super::rounded_stamps_note(self.running.resolution(), self.max_deviation, grid.dt)
+        });
         let mut ident = match self.engine.take().expect("started") {
             Engine::Algebraic {
                 id,
@@ -519,6 +541,7 @@ impl Session {
                 flagged,
                 last,
                 keep,
+                kept,
             } => {
                 if self.done < ALGEBRAIC_MIN_SAMPLES {
                     return Err(self.too_few(self.done));
@@ -533,29 +556,45 @@ impl Session {
                     id.windows(),
                 );
                 ident.estimates = keep.unwrap_or_default();
+                // judged only when its estimates settled: a refit from the late values of
+                // a noisy record starts from noise (module `adequacy`)
+                let settled = !ident
+                    .diagnostics
+                    .iter()
+                    .any(|d| matches!(d.finding, Finding::AlgebraicUnsettled { .. }));
+                if settled {
+                    if let Ok(rec) = self.record(kept, grid) {
+                        super::adequacy::judge(&mut ident, &rec, &self.knowledge);
+                    }
+                }
                 ident
             }
-            Engine::Modulating { id, kept } => {
+            Engine::Modulating { id, kept, complete } => {
                 let est = id.finish()?;
                 let Method::Modulating(s) = &self.method else {
                     unreachable!("the engine follows the method")
                 };
-                let bound = match kept {
-                    Some(kept) => self.record(kept, grid).and_then(|rec| {
-                        super::refine_run::modulating_bound(
-                            &rec,
-                            &self.knowledge,
-                            est.values(),
-                            est.sigma_x,
-                            est.sigma_z,
-                        )
-                    }),
-                    None => Err(PipelineError::CrbTooLong {
+                let rec = self.record(kept, grid);
+                let bound = match &rec {
+                    Ok(rec) if complete => super::refine_run::modulating_bound(
+                        rec,
+                        &self.knowledge,
+                        est.values(),
+                        est.sigma_x,
+                        est.sigma_z,
+                    ),
+                    Ok(_) => Err(PipelineError::CrbTooLong {
                         samples: self.done,
                         max: MODULATING_CRB_MAX_SAMPLES,
                     }),
+                    Err(e) => Err(e.clone()),
                 };
-                super::modulating_identification(info, &self.knowledge, s, &est, bound)
+                let mut ident =
+                    super::modulating_identification(info, &self.knowledge, s, &est, bound);
+                if let Ok(rec) = &rec {
+                    super::adequacy::judge(&mut ident, rec, &self.knowledge);
+                }
+                ident
             }
             Engine::Refine { kept } => {
                 let Method::Refine(s) = &self.method else {
@@ -564,10 +603,12 @@ impl Session {
                 let rec = self.record(kept, grid)?;
                 let mut ident = super::refine_run::run(&rec, &self.knowledge, s)?;
                 ident.diagnostics.extend(self.speed_check.profile_finding());
+                ident.diagnostics.extend(rounded);
                 return Ok(ident);
             }
         };
         ident.diagnostics.extend(drift);
+        ident.diagnostics.extend(rounded);
         ident.diagnostics.extend(self.magnitudes.findings());
         super::apply_speed_check(&mut ident, &self.speed_check);
         ident.diagnostics.extend(self.speed_check.profile_finding());

@@ -480,14 +480,29 @@ impl ScenarioSpec {
         }
     }
 
+    /// The rotor of a complete `[rotor]` (all nine keys), whatever else the scenario
+    /// lacks (a raw acquisition's scenario has no `[speed]`: its keyphasor gives the
+    /// speed), or the built-in scenario's; `who` needs it (named in the error of a missing
+    /// key).
+    pub fn rotor(&self, who: &str) -> Result<Rotor, ScenarioFileError> {
+        match &self.builtin {
+            Some(s) => Ok(s.rotor),
+            None => self.rotor_for(who),
+        }
+    }
+
     fn rotor_for_simulation(&self) -> Result<Rotor, ScenarioFileError> {
+        self.rotor_for("simulate")
+    }
+
+    fn rotor_for(&self, who: &str) -> Result<Rotor, ScenarioFileError> {
         let mut v = RotorArray::default();
         for (i, k) in CANONICAL_ORDER.iter().enumerate() {
             let cross = i >= 9;
             v.0[i] = if cross && self.written_model == ModelKind::Jeffcott {
                 0.0
             } else {
-                self.require_rotor(k, "simulate")?
+                self.require_rotor(k, who)?
             };
         }
         // Values were range-checked when parsed; this cannot fail, but keep the mapping.

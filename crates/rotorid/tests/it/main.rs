@@ -1,13 +1,20 @@
 //! The rotorid library against independent references (one test binary:
 //! `cargo test -p rotorid --test it`).
 
+mod cross_common;
 mod identify_common;
 
 mod acquisition;
+mod acquisition_iterated;
 mod adequacy;
 mod algebraic_windows;
 mod analysis;
 mod analysis_cross;
+mod balance;
+mod cross_algebraic;
+mod cross_modulating;
+mod cross_reference;
+mod defects;
 mod identify_accuracy;
 mod identify_conditioning;
 mod identify_convergence;
@@ -18,6 +25,7 @@ mod model_selection;
 mod modulating_clean;
 mod modulating_noise;
 mod pipeline;
+mod raw_reference;
 mod refine_clean;
 mod refine_crb;
 mod refine_cross;

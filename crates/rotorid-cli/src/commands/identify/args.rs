@@ -63,7 +63,8 @@ const TIME_TOLERANCE_TEXT: &str = "1e-6";
         "`phi_dot [rpm]`): then they are converted to SI and a `note:` line says so; t in\n",
         "s, ms, us; x, z in m, mm, um, nm, mil, in; phi in rad, deg, rev; phi_dot in rad/s,\n",
         "rpm, Hz, deg/s; phi_ddot in rad/s^2, rpm/s, Hz/s, deg/s^2. An unknown unit is an error.\n",
-        "  t [s]                 strictly increasing, uniformly sampled (see --time-tolerance)\n",
+        "  t [s]                 strictly increasing, uniformly sampled (see --time-tolerance;\n",
+        "                        stamps rounded to their printed decimals are accepted)\n",
         "  x, z [m]              disk displacement, horizontal and vertical\n",
         "  phi [rad], phi_dot [rad/s], phi_ddot [rad/s^2]\n",
         "                        optional, all three or none; without them the scenario's\n",
@@ -161,7 +162,10 @@ pub struct IdentifyArgs {
     #[command(flatten)]
     pub settings: MethodOptions,
 
-    /// Allowed deviation of each time step from dt = t_2 - t_1, relative to dt.
+    /// Allowed deviation of each time stamp from the uniform grid t0 + i dt fitted by least
+    /// squares over the stamps, relative to that dt; stamps printed with few decimals
+    /// (25.6 kHz to 6 decimals) may besides be off by one unit of their last decimal (at
+    /// most dt/4), with a `note:` saying so.
     #[arg(long, value_name = "REL", default_value = TIME_TOLERANCE_TEXT, allow_hyphen_values = true)]
     pub time_tolerance: f64,
 

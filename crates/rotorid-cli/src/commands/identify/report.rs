@@ -1,7 +1,7 @@
 //! The few lines `rotorid identify` prints on stderr for a person: per parameter the
 //! value, the truth and error when known, and (algebraic) the identification time or
 //! (modulating, refine) the standard error and Cramer-Rao bound; then every diagnostic as
-//! a `warning:` line (printed even with `--quiet`).
+//! a `warning:` line, or a `note:` line for a note (printed even with `--quiet`).
 
 use std::fmt::Write as _;
 

@@ -1,11 +1,14 @@
-//! Whole-record identification: a fold of [`AlgebraicIdentifier::push`] over the samples,
-//! so a batch gives bit-for-bit the estimates the streaming identifier gives.
+//! Whole-record identification: a fold of [`AlgebraicIdentifier::push`] (or
+//! [`CrossAlgebraicIdentifier::push`]) over the samples, so a batch gives bit-for-bit the
+//! estimates the streaming identifier gives.
 
 use super::config::AlgebraicConfig;
+use super::cross::CrossAlgebraicIdentifier;
+use super::cross_estimate::CrossAlgebraicEstimate;
 use super::error::AlgebraicError;
 use super::estimate::AlgebraicEstimate;
 use super::identifier::AlgebraicIdentifier;
-use crate::identify::sampling::record_dt;
+use crate::identify::sampling::record_columns_dt;
 use crate::identify::{Known, Measurement};
 use crate::model::SpeedState;
 use crate::simulate::TimeResponse;
@@ -32,23 +35,52 @@ pub fn identify_response(
     known: Known,
     config: AlgebraicConfig,
 ) -> Result<Vec<AlgebraicEstimate>, AlgebraicError> {
-    let dt = record_dt(
+    let dt = response_dt(resp)?;
+    let mut id = AlgebraicIdentifier::new(known, dt, config)?;
+    (0..resp.len())
+        .map(|i| id.push(&measurement(resp, i)))
+        .collect()
+}
+
+/// The cross-coupled identifier ([`CrossAlgebraicIdentifier`]) over `measurements`
+/// (uniformly sampled every `dt` \[s\]): one estimate per measurement. Stops at the first
+/// invalid measurement with its error.
+pub fn identify_cross_batch(
+    measurements: &[Measurement],
+    known: Known,
+    dt: f64,
+    config: AlgebraicConfig,
+) -> Result<Vec<CrossAlgebraicEstimate>, AlgebraicError> {
+    let mut id = CrossAlgebraicIdentifier::new(known, dt, config)?;
+    measurements.iter().map(|m| id.push(m)).collect()
+}
+
+/// The cross-coupled identifier over a simulated record; dt is `t[1] - t[0]` (at least 2
+/// samples).
+pub fn identify_cross_response(
+    resp: &TimeResponse,
+    known: Known,
+    config: AlgebraicConfig,
+) -> Result<Vec<CrossAlgebraicEstimate>, AlgebraicError> {
+    let dt = response_dt(resp)?;
+    let mut id = CrossAlgebraicIdentifier::new(known, dt, config)?;
+    (0..resp.len())
+        .map(|i| id.push(&measurement(resp, i)))
+        .collect()
+}
+
+/// The sampling period of `resp` after checking its columns (see `record_dt`).
+fn response_dt(resp: &TimeResponse) -> Result<f64, AlgebraicError> {
+    Ok(record_columns_dt(
         &resp.t,
         [
-            ("x", resp.x.len()),
-            ("z", resp.z.len()),
-            ("phi", resp.phi.len()),
-            ("phi_dot", resp.phi_dot.len()),
-            ("phi_ddot", resp.phi_ddot.len()),
+            resp.x.len(),
+            resp.z.len(),
+            resp.phi.len(),
+            resp.phi_dot.len(),
+            resp.phi_ddot.len(),
         ],
-    )?;
-    let mut id = AlgebraicIdentifier::new(known, dt, config)?;
-    let n = resp.t.len();
-    let mut out = Vec::with_capacity(n);
-    for i in 0..n {
-        out.push(id.push(&measurement(resp, i))?);
-    }
-    Ok(out)
+    )?)
 }
 
 /// Sample `i` of `resp` as a [`Measurement`].

@@ -23,6 +23,22 @@ use crate::model::check;
 /// See `tests/identify_conditioning.rs`.
 pub const DEFAULT_ALGEBRAIC_RCOND_MIN: f64 = 1e-5;
 
+/// Default [`AlgebraicConfig::rcond_min`] for the cross-coupled identifier
+/// ([`super::CrossAlgebraicIdentifier`]): the same value as the Jeffcott identifier's, so
+/// [`AlgebraicConfig::default`] serves both, but a different matrix (the two-sided
+/// equilibrated 5x5 system, [`super::cross_solve`]).
+///
+/// Calibrated on exact data (dt = 0.1 ms, 1 s, default quadrature; tests
+/// `cross_algebraic.rs`): table1 and four cross-coupled rotors at 1200 rpm and on the
+/// 10 rad/s^2 ramps from rest and from 1200 rpm. Every unflagged estimate from 20 ms on is
+/// within 1e-3 of the truth (cross terms against the direct coefficient of their row). Far
+/// more instants are flagged than for the 3x3 system (12-30 % on table1, up to 83 % on a
+/// well-damped cross-coupled rotor at constant speed): once the free transient has died
+/// out, a single-frequency response cannot separate m from the stiffness (P\[y\] = -W^2 R\[y\]
+/// for a sinusoid of frequency W) nor the five coefficients of a row, and the 5x5 system
+/// says so. Data errors raise an instant's error to ~(data error)/rcond, as for the 3x3.
+pub const DEFAULT_CROSS_ALGEBRAIC_RCOND_MIN: f64 = DEFAULT_ALGEBRAIC_RCOND_MIN;
+
 /// How the rotor angle and speed are obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub enum SpeedModel {

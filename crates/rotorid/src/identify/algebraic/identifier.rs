@@ -66,13 +66,13 @@ use crate::model::check;
 /// Number of integrated signals: (y, tau y, tau^2 y, u, v) for y = x, z, interleaved
 /// (x then z for each) so that the two directions sit in adjacent lanes, and two zeros
 /// (padding to a multiple of the 4 SIMD lanes of the cascade).
-const NS: usize = 12;
+pub(super) const NS: usize = 12;
 /// Offsets of each pair (x at the offset, z right after).
-const Y: usize = 0;
-const TY: usize = 2;
-const T2Y: usize = 4;
-const U: usize = 6;
-const V: usize = 8;
+pub(super) const Y: usize = 0;
+pub(super) const TY: usize = 2;
+pub(super) const T2Y: usize = 4;
+pub(super) const U: usize = 6;
+pub(super) const V: usize = 8;
 
 /// The streaming algebraic identifier (module docs). Feed it measurements in time order
 /// with [`push`](Self::push); each returns the estimate at that instant.
@@ -193,50 +193,64 @@ impl AlgebraicIdentifier {
 
     #[inline(always)]
     fn validate(&self, m: &Measurement) -> Result<(), AlgebraicError> {
-        let general = self.config.speed_model == SpeedModel::General;
-        // v * 0 == 0 exactly when v is finite: one test for all fields.
-        let s = &m.speed;
-        let speed_zero = if general {
-            s.phi * 0.0 + s.omega * 0.0 + s.omega_dot * 0.0
-        } else {
-            0.0
-        };
-        if m.t * 0.0 + m.x * 0.0 + m.z * 0.0 + speed_zero != 0.0 {
-            return Err(self.not_finite(m, general));
-        }
-        if self.n > 0 {
-            check_on_time(self.n, m.t, self.t_prev, self.dt)?;
-        }
-        Ok(())
+        validate(m, self.config.speed_model, self.n, self.t_prev, self.dt)
     }
+}
 
-    /// The error naming the first non-finite field of `m`.
-    #[cold]
-    fn not_finite(&self, m: &Measurement, general: bool) -> AlgebraicError {
-        let s = &m.speed;
-        let fields = [
-            ("t", m.t, true),
-            ("x", m.x, true),
-            ("z", m.z, true),
-            ("phi", s.phi, general),
-            ("phi_dot", s.omega, general),
-            ("phi_ddot", s.omega_dot, general),
-        ];
-        let (field, value, _) = fields
-            .into_iter()
-            .find(|&(_, v, checked)| checked && !v.is_finite())
-            .unwrap_or(("t", m.t, true));
-        AlgebraicError::Input(InputError::NotFinite {
-            index: self.n,
-            field,
-            value,
-        })
+/// Check measurement `m`, the `n`-th since the start (the previous one at `t_prev` \[s\]),
+/// for the identifier of period `dt` \[s\] and speed model `model`: every field it uses
+/// finite, and on the uniform grid ([`AlgebraicIdentifier::push`] states the errors).
+#[inline(always)]
+pub(super) fn validate(
+    m: &Measurement,
+    model: SpeedModel,
+    n: u64,
+    t_prev: f64,
+    dt: f64,
+) -> Result<(), AlgebraicError> {
+    let general = model == SpeedModel::General;
+    // v * 0 == 0 exactly when v is finite: one test for all fields.
+    let s = &m.speed;
+    let speed_zero = if general {
+        s.phi * 0.0 + s.omega * 0.0 + s.omega_dot * 0.0
+    } else {
+        0.0
+    };
+    if m.t * 0.0 + m.x * 0.0 + m.z * 0.0 + speed_zero != 0.0 {
+        return Err(not_finite(m, general, n));
     }
+    if n > 0 {
+        check_on_time(n, m.t, t_prev, dt)?;
+    }
+    Ok(())
+}
+
+/// The error naming the first non-finite field of `m`, sample `index`.
+#[cold]
+fn not_finite(m: &Measurement, general: bool, index: u64) -> AlgebraicError {
+    let s = &m.speed;
+    let fields = [
+        ("t", m.t, true),
+        ("x", m.x, true),
+        ("z", m.z, true),
+        ("phi", s.phi, general),
+        ("phi_dot", s.omega, general),
+        ("phi_ddot", s.omega_dot, general),
+    ];
+    let (field, value, _) = fields
+        .into_iter()
+        .find(|&(_, v, checked)| checked && !v.is_finite())
+        .unwrap_or(("t", m.t, true));
+    AlgebraicError::Input(InputError::NotFinite {
+        index,
+        field,
+        value,
+    })
 }
 
 /// (sin(phi + alpha), cos(phi + alpha), w, w') for the measurement `m`.
 #[inline(always)]
-fn speed_at(known: &Known, model: SpeedModel, m: &Measurement) -> (f64, f64, f64, f64) {
+pub(super) fn speed_at(known: &Known, model: SpeedModel, m: &Measurement) -> (f64, f64, f64, f64) {
     match model {
         SpeedModel::General => {
             let (sn, cs) = sin_cos(m.speed.phi + known.alpha);
@@ -250,7 +264,7 @@ fn speed_at(known: &Known, model: SpeedModel, m: &Measurement) -> (f64, f64, f64
 }
 
 /// True when the CPU supports AVX2 (x86_64 only).
-fn has_avx2() -> bool {
+pub(super) fn has_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx2")
@@ -265,7 +279,16 @@ fn has_avx2() -> bool {
 /// two padding zeros.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn signals(k: &Known, tau: f64, x: f64, z: f64, sn: f64, cs: f64, w: f64, wd: f64) -> [f64; NS] {
+pub(super) fn signals(
+    k: &Known,
+    tau: f64,
+    x: f64,
+    z: f64,
+    sn: f64,
+    cs: f64,
+    w: f64,
+    wd: f64,
+) -> [f64; NS] {
     let t2 = tau * tau;
     let w2 = w * w;
     let fx = w2 * sn - wd * cs;

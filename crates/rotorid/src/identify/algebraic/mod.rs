@@ -16,11 +16,22 @@
 //! - [`ConvergenceTracker`]: final values and identification times in bounded memory.
 //! - [`identify_batch`], [`identify_response`]: whole records.
 //!
-//! `simd` holds the two-lane (x and z) arithmetic the solve runs on.
+//! The cross-coupled rotor (issue 26; docs/method.md section 3.10): per row m and that
+//! row's four bearing coefficients, five unknowns, from the same scalar equation and its
+//! iterated integrals I1..I4 (a 5x5 system of I0..I6 of the same signals):
+//!
+//! - [`CrossAlgebraicIdentifier`]: one [`CrossAlgebraicEstimate`] per measurement.
+//! - [`cross_solve`]: scaling, LU solution and exact 1-norm rcond of the 5x5 system.
+//! - [`identify_cross_batch`], [`identify_cross_response`]: whole records.
+//!
+//! `simd` holds the two-lane (x and z) arithmetic the solves run on.
 
 mod batch;
 mod config;
 mod convergence;
+mod cross;
+mod cross_estimate;
+pub mod cross_solve;
 mod error;
 mod estimate;
 mod identifier;
@@ -29,11 +40,18 @@ pub mod scaled_solve;
 mod simd;
 mod windows;
 
-pub use batch::{identify_batch, identify_response, measurement};
-pub use config::{AlgebraicConfig, SpeedModel, DEFAULT_ALGEBRAIC_RCOND_MIN};
+pub use batch::{
+    identify_batch, identify_cross_batch, identify_cross_response, identify_response, measurement,
+};
+pub use config::{
+    AlgebraicConfig, SpeedModel, DEFAULT_ALGEBRAIC_RCOND_MIN, DEFAULT_CROSS_ALGEBRAIC_RCOND_MIN,
+};
 pub use convergence::{
     ConvergenceTracker, ParameterConvergence, DEFAULT_STACK_CAPACITY, DEFAULT_TOLERANCE,
 };
+pub use cross::CrossAlgebraicIdentifier;
+pub use cross_estimate::{CrossAlgebraicEstimate, CrossDirectionEstimate};
+pub use cross_solve::{solve_scaled5, ScaledSolution5};
 pub use error::AlgebraicError;
 pub use estimate::{AlgebraicEstimate, DirectionEstimate};
 pub use identifier::AlgebraicIdentifier;

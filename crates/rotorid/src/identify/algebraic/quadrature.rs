@@ -6,7 +6,9 @@
 //! ```
 //!
 //! on a uniform grid t_n = t_0 + n h. Level k is integrated from the values of level k - 1
-//! at the nodes (a cascade), so each level carries the rule's order of accuracy.
+//! at the nodes (a cascade), so each level carries the rule's order of accuracy. The
+//! Jeffcott identifier needs I1..I4 ([`LEVELS`], the default); the cross-coupled one
+//! I1..I6 ([`RunningIntegrals`]'s second parameter, the number of rows R = levels + 1).
 //!
 //! ## Rules (Adams-Moulton, Hairer, Nørsett & Wanner, *Solving ODEs I*, section III.1)
 //!
@@ -44,7 +46,8 @@ use serde::{Deserialize, Serialize};
 use super::error::AlgebraicError;
 use crate::model::check;
 
-/// Number of iterated-integral levels kept by [`RunningIntegrals`] (I1 to I4).
+/// Number of iterated-integral levels kept by [`RunningIntegrals`] by default (I1 to I4,
+/// what the 3x3 system of docs/method.md section 3.4 needs).
 pub const LEVELS: usize = 4;
 
 /// The running quadrature rule used for every iterated integral.
@@ -179,10 +182,10 @@ pub fn lagrange_cumulative_weights<const Q: usize>(m: usize) -> [[f64; Q]; Q] {
 }
 
 /// The cascade for a stencil of Q nodes: a ring of the last Q nodes, each holding the
-/// integrand (level 0) and levels 1..=LEVELS for NS signals.
+/// integrand (level 0) and levels 1..R-1 for NS signals.
 #[derive(Debug, Clone)]
-struct Cascade<const NS: usize, const Q: usize> {
-    ring: [[[f64; NS]; LEVELS + 1]; Q],
+struct Cascade<const NS: usize, const Q: usize, const R: usize> {
+    ring: [[[f64; NS]; R]; Q],
     /// Slot of the newest node.
     head: usize,
     /// Nodes pushed so far.
@@ -196,9 +199,10 @@ struct Cascade<const NS: usize, const Q: usize> {
     start: [[[f64; Q]; Q]; Q],
 }
 
-impl<const NS: usize, const Q: usize> Cascade<NS, Q> {
+impl<const NS: usize, const Q: usize, const R: usize> Cascade<NS, Q, R> {
     fn new(beta: &[f64], h: f64) -> Self {
         debug_assert!(beta.len() == Q && Q <= 5);
+        const { assert!(R >= 2, "at least one level of integrals") };
         let mut step = [[0.0; Q]; Q];
         for (r, row) in step.iter_mut().enumerate() {
             for (s, c) in row.iter_mut().enumerate() {
@@ -216,7 +220,7 @@ impl<const NS: usize, const Q: usize> Cascade<NS, Q> {
             }
         }
         Self {
-            ring: [[[0.0; NS]; LEVELS + 1]; Q],
+            ring: [[[0.0; NS]; R]; Q],
             head: 0,
             nodes: 0,
             step,
@@ -226,13 +230,13 @@ impl<const NS: usize, const Q: usize> Cascade<NS, Q> {
     }
 
     fn reset(&mut self) {
-        self.ring = [[[0.0; NS]; LEVELS + 1]; Q];
+        self.ring = [[[0.0; NS]; R]; Q];
         self.head = 0;
         self.nodes = 0;
     }
 
     #[inline]
-    fn levels(&self) -> &[[f64; NS]; LEVELS + 1] {
+    fn levels(&self) -> &[[f64; NS]; R] {
         &self.ring[self.head]
     }
 
@@ -252,10 +256,10 @@ impl<const NS: usize, const Q: usize> Cascade<NS, Q> {
     fn step_startup(&mut self, f: &[f64; NS]) {
         let last = self.nodes as usize; // index of the new node
         self.head = last;
-        self.ring[last] = [[0.0; NS]; LEVELS + 1];
+        self.ring[last] = [[0.0; NS]; R];
         self.ring[last][0] = *f;
         let w = self.start[last];
-        for k in 1..=LEVELS {
+        for k in 1..R {
             for (j, wj) in w.iter().enumerate().take(last + 1).skip(1) {
                 let mut acc = [0.0; NS];
                 for (i, wi) in wj.iter().enumerate().take(last + 1) {
@@ -284,13 +288,13 @@ impl<const NS: usize, const Q: usize> Cascade<NS, Q> {
         }
     }
 
-    /// One step with the new node going to slot R (R < Q; Q <= 5), in chunks of 4 signals
+    /// One step with the new node going to slot SLOT (< Q; Q <= 5), in chunks of 4 signals
     /// (SIMD lanes; a scalar loop takes the NS % 4 left over). For each level: the sum
     /// over the q - 1 older nodes first, then the newest node's term.
     #[inline(always)]
-    fn step_phase<const R: usize>(&mut self, f: &[f64; NS]) {
+    fn step_phase<const SLOT: usize>(&mut self, f: &[f64; NS]) {
         const W: usize = 4;
-        let r = R % Q; // R < Q always; the modulo only keeps unused arms in bounds
+        let r = SLOT % Q; // SLOT < Q always; the modulo only keeps unused arms in bounds
         let old = (r + Q - 1) % Q;
         self.head = r;
         let c = self.step[r];
@@ -300,7 +304,7 @@ impl<const NS: usize, const Q: usize> Cascade<NS, Q> {
         for base in (0..full).step_by(W) {
             let mut below: [f64; W] = std::array::from_fn(|l| f[base + l]);
             ring[r][0][base..base + W].copy_from_slice(&below);
-            for k in 1..=LEVELS {
+            for k in 1..R {
                 let mut acc: [f64; W] = std::array::from_fn(|l| ring[old][k][base + l]);
                 for (s, cs) in c.iter().enumerate() {
                     if s != r {
@@ -320,7 +324,7 @@ impl<const NS: usize, const Q: usize> Cascade<NS, Q> {
         for j in full..NS {
             let mut below = f[j];
             ring[r][0][j] = below;
-            for k in 1..=LEVELS {
+            for k in 1..R {
                 let mut acc = ring[old][k][j];
                 for (s, cs) in c.iter().enumerate() {
                     if s != r {
@@ -339,15 +343,17 @@ impl<const NS: usize, const Q: usize> Cascade<NS, Q> {
 /// largest variant is a few kB).
 #[derive(Debug, Clone)]
 #[allow(clippy::large_enum_variant)]
-enum Engine<const NS: usize> {
-    Q2(Cascade<NS, 2>),
-    Q3(Cascade<NS, 3>),
-    Q4(Cascade<NS, 4>),
-    Q5(Cascade<NS, 5>),
+enum Engine<const NS: usize, const R: usize> {
+    Q2(Cascade<NS, 2, R>),
+    Q3(Cascade<NS, 3, R>),
+    Q4(Cascade<NS, 4, R>),
+    Q5(Cascade<NS, 5, R>),
 }
 
-/// Running iterated integrals I1..I4 of NS signals sampled every h, with a selectable
-/// [`Quadrature`]. O(NS q) work and no allocation per sample.
+/// Running iterated integrals I1..I(R-1) of NS signals sampled every h, with a selectable
+/// [`Quadrature`]. O(NS q R) work and no allocation per sample. R, the number of rows
+/// kept (the signals and R - 1 levels), is [`LEVELS`] + 1 = 5 unless given (the
+/// cross-coupled identifier keeps 7: I1..I6).
 ///
 /// ```
 /// use rotorid::identify::algebraic::{Quadrature, RunningIntegrals};
@@ -360,13 +366,13 @@ enum Engine<const NS: usize> {
 /// assert!((ri.levels()[1][0] - 1f64.sin()).abs() < 1e-13);
 /// ```
 #[derive(Debug, Clone)]
-pub struct RunningIntegrals<const NS: usize> {
+pub struct RunningIntegrals<const NS: usize, const R: usize = { LEVELS + 1 }> {
     quadrature: Quadrature,
     h: f64,
-    engine: Engine<NS>,
+    engine: Engine<NS, R>,
 }
 
-impl<const NS: usize> RunningIntegrals<NS> {
+impl<const NS: usize, const R: usize> RunningIntegrals<NS, R> {
     /// Integrals of signals sampled every `h` \[s\] (finite, > 0) with `quadrature`.
     pub fn new(quadrature: Quadrature, h: f64) -> Result<Self, AlgebraicError> {
         check("dt", h, "finite and > 0 (s)", |v| v > 0.0)?;
@@ -434,7 +440,7 @@ impl<const NS: usize> RunningIntegrals<NS> {
     /// The values at the newest node: `levels()[0]` the signals themselves, `levels()[k]`
     /// their k-fold iterated integrals Ik from t_0 (all zero before the first sample).
     #[inline]
-    pub fn levels(&self) -> &[[f64; NS]; LEVELS + 1] {
+    pub fn levels(&self) -> &[[f64; NS]; R] {
         match &self.engine {
             Engine::Q2(c) => c.levels(),
             Engine::Q3(c) => c.levels(),
@@ -503,6 +509,64 @@ mod tests {
     fn bad_step_is_rejected() {
         assert!(RunningIntegrals::<1>::new(Quadrature::Trapezoid, 0.0).is_err());
         assert!(RunningIntegrals::<1>::new(Quadrature::Trapezoid, f64::NAN).is_err());
+    }
+
+    #[test]
+    fn six_levels_integrate_exp_to_the_rule_order() {
+        // I_k[e^t](t) = e^t - sum_{j<k} t^j / j!: levels 1..6 (the cross-coupled
+        // identifier's), error O(h^p) at every level; halving h divides it by ~2^p.
+        let err = |q: Quadrature, h: f64| -> [f64; 6] {
+            let mut ri = RunningIntegrals::<1, 7>::new(q, h).unwrap();
+            let n = (1.0 / h).round() as usize;
+            for i in 0..=n {
+                ri.push(&[(i as f64 * h).exp()]);
+            }
+            std::array::from_fn(|k| {
+                let k = k + 1;
+                let (mut poly, mut term) = (0.0, 1.0);
+                for j in 0..k {
+                    poly += term;
+                    term /= (j + 1) as f64;
+                }
+                (ri.levels()[k][0] - (1f64.exp() - poly)).abs() / (1f64.exp() - poly)
+            })
+        };
+        for q in [Quadrature::AdamsMoulton4, Quadrature::AdamsMoulton5] {
+            let (coarse, fine) = (err(q, 1.0 / 40.0), err(q, 1.0 / 80.0));
+            for k in 0..6 {
+                let ratio = coarse[k] / fine[k];
+                let p = q.order() as f64;
+                assert!(
+                    ratio > 2f64.powf(p - 0.5) && ratio < 2f64.powf(p + 0.5),
+                    "{q} level {}: {} -> {} (ratio {ratio})",
+                    k + 1,
+                    coarse[k],
+                    fine[k]
+                );
+            }
+            let limit = if q == Quadrature::AdamsMoulton5 {
+                2e-8
+            } else {
+                1e-6
+            };
+            assert!(fine[5] < limit, "{q}: {fine:?}");
+        }
+    }
+
+    #[test]
+    fn more_levels_leave_the_first_four_unchanged() {
+        // the cascade is level by level: keeping I5, I6 does not touch I1..I4
+        let mut four = RunningIntegrals::<3>::new(Quadrature::AdamsMoulton5, 1e-3).unwrap();
+        let mut six = RunningIntegrals::<3, 7>::new(Quadrature::AdamsMoulton5, 1e-3).unwrap();
+        for i in 0..500 {
+            let t = i as f64 * 1e-3;
+            let f = [t.sin(), (3.0 * t).cos(), t * t];
+            four.push(&f);
+            six.push(&f);
+            for k in 0..5 {
+                assert_eq!(four.levels()[k], six.levels()[k]);
+            }
+        }
     }
 
     #[test]

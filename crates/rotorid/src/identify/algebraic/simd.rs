@@ -1,5 +1,6 @@
-//! Two f64 lanes, one per direction (x, z), so that the two 3x3 systems of
-//! [`super::system`] are solved with one SIMD instruction per operation.
+//! Two f64 lanes, one per direction (x, z), so that the two 3x3 systems of `scaled_solve`
+//! (and the two 5x5 systems of `cross_solve`) are solved with one SIMD instruction per
+//! operation.
 //!
 //! Every operation is the IEEE-754 operation lane by lane (no fused multiply-add, no
 //! reassociation), so the results are bit-for-bit those of the scalar code. On x86_64 the
@@ -87,6 +88,19 @@ mod imp {
                 ))
             }
         }
+        /// Per lane: `if self > o { yes } else { no }` (`no` when either is NaN).
+        #[inline(always)]
+        pub(crate) fn pick_gt(self, o: Self, yes: Self, no: Self) -> Self {
+            unsafe {
+                let gt = _mm_cmpgt_pd(self.0, o.0);
+                F2(_mm_or_pd(_mm_and_pd(gt, yes.0), _mm_andnot_pd(gt, no.0)))
+            }
+        }
+        /// `self > o` in either lane (false for NaN).
+        #[inline(always)]
+        pub(crate) fn any_gt(self, o: Self) -> bool {
+            unsafe { _mm_movemask_pd(_mm_cmpgt_pd(self.0, o.0)) != 0 }
+        }
     }
 }
 
@@ -159,6 +173,21 @@ mod imp {
                 }
             };
             F2([pick(0), pick(1)])
+        }
+        #[inline(always)]
+        pub(crate) fn pick_gt(self, o: Self, yes: Self, no: Self) -> Self {
+            let pick = |l: usize| {
+                if self.0[l] > o.0[l] {
+                    yes.0[l]
+                } else {
+                    no.0[l]
+                }
+            };
+            F2([pick(0), pick(1)])
+        }
+        #[inline(always)]
+        pub(crate) fn any_gt(self, o: Self) -> bool {
+            self.0[0] > o.0[0] || self.0[1] > o.0[1]
         }
     }
 }
@@ -239,6 +268,10 @@ mod tests {
                 let sel = F2::splat(7.0).select_ok(x, y, F2::splat(-1.0)).to_array();
                 assert_eq!(sel[0], if a == 0.0 && b > 0.0 { 7.0 } else { -1.0 });
                 assert_eq!(sel[1], if b == 0.0 && a > 0.0 { 7.0 } else { -1.0 });
+                let pick = x.pick_gt(y, F2::splat(1.0), F2::splat(2.0)).to_array();
+                assert_eq!(pick[0], if a > b { 1.0 } else { 2.0 });
+                assert_eq!(pick[1], if b > a { 1.0 } else { 2.0 });
+                assert_eq!(x.any_gt(y), a > b || b > a);
             }
         }
         assert_eq!(F2::new(1.0, 2.0).to_array(), [1.0, 2.0]);

@@ -2,7 +2,8 @@
 //! accumulated on the fly, the normal equations updated as each window completes.
 //!
 //! Per window j (start t_j, length L, u = 2 (t - t_j)/L - 1) and test function psi_i, the
-//! sums over the window's samples (u-derivatives of psi, see `test_functions`)
+//! sums over the window's samples (u-derivatives of psi, see `test_functions`; accumulated
+//! by module `stream`, which the cross-coupled identifier shares)
 //!
 //! ```text
 //! Sxx'' = sum psi'' x   Sx' = sum psi' x   Sx = sum psi x   Swz' = sum psi' w z   Sfx = sum psi fx
@@ -29,36 +30,10 @@ use std::collections::VecDeque;
 use super::config::{ModulatingConfig, NoiseCompensation};
 use super::error::ModulatingError;
 use super::estimate::{ModulatingDirection, ModulatingEstimate};
-use super::noise_estimate::DifferenceNoise;
 use super::normal_equations::Gram;
-use super::test_functions::TestFunctions;
-use super::uncertainty::{add_pair, ClosedWindow, Meat, Overlaps};
-use crate::identify::sampling::check_on_time;
-use crate::identify::InputError;
+use super::stream::{setup, OpenWindow, WindowStream};
+use super::uncertainty::{add_pair, pair_overlapping, ClosedWindow, Meat, Overlaps};
 use crate::identify::{Known, Measurement};
-use crate::model::{check, OutOfRange};
-
-/// Sums per test function in an open window (module docs).
-const NSUM: usize = 11;
-
-/// Fewest sampling intervals per test function in a window.
-pub const MIN_INTERVALS_PER_FUNCTION: usize = 8;
-/// Fewest sampling intervals in a window, whatever the number of functions.
-pub const MIN_INTERVALS: usize = 24;
-/// Largest (sampling intervals per window) * functions^2.
-const MAX_TABLE: f64 = 1e7;
-
-/// A window that has started and not yet ended.
-#[derive(Debug, Clone)]
-struct OpenWindow {
-    /// Index of its first sample.
-    start: u64,
-    /// `NSUM` sums per test function.
-    sums: Vec<[f64; NSUM]>,
-    /// w \[rad/s\] and w' \[rad/s^2\] at the centre sample.
-    w: f64,
-    w_dot: f64,
-}
 
 /// The streaming modulating-function identifier (module docs of `modulating`). Feed it
 /// measurements in time order with [`push`](Self::push); ask for the estimate from all
@@ -66,76 +41,35 @@ struct OpenWindow {
 #[derive(Debug, Clone)]
 pub struct ModulatingIdentifier {
     known: Known,
-    dt: f64,
     config: ModulatingConfig,
-    tf: TestFunctions,
-    /// Hop in samples.
-    hop: u64,
-    open: VecDeque<OpenWindow>,
+    stream: WindowStream<false>,
     /// Completed windows that the next ones may overlap.
-    closed: VecDeque<ClosedWindow>,
+    closed: VecDeque<ClosedWindow<3>>,
     overlaps: Overlaps,
     /// Normal equations, x and z.
-    gram: [Gram; 2],
+    gram: [Gram<3>; 2],
     /// Covariance sums, x and z.
     meat: [Meat; 2],
     windows: u64,
-    /// Time of the last sample of the last completed window \[s\].
-    t_window_end: f64,
-    noise: [DifferenceNoise; 2],
-    /// Samples accepted.
-    n: u64,
-    t_prev: f64,
 }
 
 impl ModulatingIdentifier {
     /// An identifier for data sampled every `dt` \[s\] (finite, > 0) with the known
     /// quantities `known` and `config` (validated; the window must span at least
-    /// [`MIN_INTERVALS_PER_FUNCTION`] sampling intervals per test function and
-    /// [`MIN_INTERVALS`], and at most 1e7 / functions^2).
+    /// [`MIN_INTERVALS_PER_FUNCTION`](super::MIN_INTERVALS_PER_FUNCTION) sampling intervals
+    /// per test function and [`MIN_INTERVALS`](super::MIN_INTERVALS), and at most
+    /// 1e7 / functions^2).
     pub fn new(known: Known, dt: f64, config: ModulatingConfig) -> Result<Self, ModulatingError> {
-        let known = known.validated()?;
-        let dt = check("dt", dt, "finite and > 0 (s)", |v| v > 0.0)?;
-        let config = config.validated()?;
-        let intervals = (config.window_s / dt).round();
-        let needed = (MIN_INTERVALS_PER_FUNCTION * config.functions).max(MIN_INTERVALS);
-        if intervals < needed as f64 {
-            return Err(ModulatingError::WindowTooShort {
-                window_s: config.window_s,
-                dt,
-                intervals: intervals as usize,
-                needed,
-                functions: config.functions,
-            });
-        }
-        // the tables grow as intervals * functions^2 (module `uncertainty`)
-        if intervals * (config.functions * config.functions) as f64 > MAX_TABLE {
-            return Err(OutOfRange {
-                field: "window_s",
-                value: config.window_s,
-                allowed: "at most 1e7 / functions^2 sampling intervals (s)",
-            }
-            .into());
-        }
-        let hop = (config.hop_s / dt).round().max(1.0).min(intervals) as u64;
-        let tf = TestFunctions::new(intervals as usize, config.functions);
-        let overlaps = Overlaps::new(&tf, hop as usize);
+        let s = setup(known, dt, config)?;
         Ok(Self {
-            known,
-            dt,
-            config,
-            tf,
-            hop,
-            open: VecDeque::new(),
+            known: s.known,
+            config: s.config,
+            stream: WindowStream::new(s.dt, s.tf, s.hop),
             closed: VecDeque::new(),
-            overlaps,
+            overlaps: s.overlaps,
             gram: [Gram::default(); 2],
             meat: [Meat::default(); 2],
             windows: 0,
-            t_window_end: f64::NAN,
-            noise: [DifferenceNoise::default(); 2],
-            n: 0,
-            t_prev: f64::NAN,
         })
     }
 
@@ -146,22 +80,22 @@ impl ModulatingIdentifier {
 
     /// The window length used, L = whole sampling intervals * dt \[s\].
     pub fn window_s(&self) -> f64 {
-        self.tf.intervals() as f64 * self.dt
+        self.stream.window_s()
     }
 
     /// The hop used \[s\].
     pub fn hop_s(&self) -> f64 {
-        self.hop as f64 * self.dt
+        self.stream.hop_s()
     }
 
     /// Samples in one window (intervals + 1).
     pub fn window_samples(&self) -> usize {
-        self.tf.intervals() + 1
+        self.stream.window_samples()
     }
 
     /// Samples accepted so far.
     pub fn samples(&self) -> u64 {
-        self.n
+        self.stream.n
     }
 
     /// Windows completed so far.
@@ -173,72 +107,21 @@ impl ModulatingIdentifier {
     /// caller may skip the sample): a non-finite field, or a time that is not the previous
     /// one plus dt within `1e-6 dt + 8 ulp(t)`.
     pub fn push(&mut self, m: &Measurement) -> Result<(), ModulatingError> {
-        self.validate(m)?;
-        let s = &m.speed;
-        let (w, wd) = (s.omega, s.omega_dot);
-        let (sn, cs) = (s.phi + self.known.alpha).sin_cos();
-        let w2 = w * w;
-        let (x, z) = (m.x, m.z);
-        let q = [
-            x,
-            z,
-            w * z,
-            w * x,
-            wd * x,
-            w2 * sn - wd * cs,
-            wd * sn + w2 * cs,
-        ];
-        if self.n.is_multiple_of(self.hop) {
-            self.open.push_back(OpenWindow {
-                start: self.n,
-                sums: vec![[0.0; NSUM]; self.tf.functions()],
-                w: f64::NAN,
-                w_dot: f64::NAN,
-            });
-        }
-        let centre = self.tf.intervals() / 2;
-        for win in self.open.iter_mut() {
-            let k = (self.n - win.start) as usize;
-            if k == centre {
-                (win.w, win.w_dot) = (w, wd);
-            }
-            for (s, &[p, p1, p2]) in win.sums.iter_mut().zip(self.tf.at(k)) {
-                let [x, z, wz, wx, wdx, fx, fz] = q;
-                s[0] += p2 * x;
-                s[1] += p1 * x;
-                s[2] += p * x;
-                s[3] += p1 * wz;
-                s[4] += p * fx;
-                s[5] += p2 * z;
-                s[6] += p1 * z;
-                s[7] += p * z;
-                s[8] += p1 * wx;
-                s[9] += p * wdx;
-                s[10] += p * fz;
-            }
-        }
-        let intervals = self.tf.intervals() as u64;
-        while let Some(front) = self.open.front() {
-            if self.n - front.start < intervals {
-                break;
-            }
-            let win = self.open.pop_front().expect("front exists");
+        self.stream.validate(m)?;
+        self.stream.accumulate(m, self.known.alpha);
+        while let Some(win) = self.stream.pop_complete(m.t) {
             self.close(&win);
-            self.t_window_end = m.t;
         }
-        self.noise[0].push(x);
-        self.noise[1].push(z);
-        self.n += 1;
-        self.t_prev = m.t;
+        self.stream.advance(m);
         Ok(())
     }
 
     /// Add the rows of a completed window to the normal equations and its pairs with the
     /// completed windows it overlaps to the covariance sums.
     fn close(&mut self, win: &OpenWindow) {
-        let two_l = 2.0 / self.tf.intervals() as f64 / self.dt;
+        let two_l = self.stream.two_l();
         let (a, mud) = (self.known.a, self.known.mud);
-        let f = self.tf.functions();
+        let f = self.stream.tf.functions();
         let mut done = ClosedWindow {
             start: win.start,
             phi: [Vec::with_capacity(f), Vec::with_capacity(f)],
@@ -247,33 +130,22 @@ impl ModulatingIdentifier {
         };
         for s in &win.sums {
             let (px, pz) = ([s[0], -s[1], s[2]], [s[5], -s[6], s[7]]);
-            self.gram[0].add([px[0], px[1], px[2], -a * two_l * s[3] + mud * s[4]]);
-            self.gram[1].add([
-                pz[0],
-                pz[1],
-                pz[2],
-                a * two_l * s[8] + a * s[9] + mud * s[10],
-            ]);
+            self.gram[0].add(&px, -a * two_l * s[3] + mud * s[4]);
+            self.gram[1].add(&pz, a * two_l * s[8] + a * s[9] + mud * s[10]);
             done.phi[0].push(px);
             done.phi[1].push(pz);
         }
         // pairs with the earlier windows that overlap this one, and with itself
-        let reach = self.tf.intervals() as u64;
-        while self
-            .closed
-            .front()
-            .is_some_and(|c| done.start - c.start > reach)
-        {
-            self.closed.pop_front();
-        }
-        for early in &self.closed {
-            let lag = ((done.start - early.start) / self.hop) as usize;
-            if lag < self.overlaps.lags() {
-                add_pair(&mut self.meat, &self.overlaps, early, &done, lag, a, two_l);
-            }
-        }
-        add_pair(&mut self.meat, &self.overlaps, &done, &done, 0, a, two_l);
-        self.closed.push_back(done);
+        let meat = &mut self.meat;
+        let overlaps = &self.overlaps;
+        pair_overlapping(
+            &mut self.closed,
+            done,
+            self.stream.tf.intervals() as u64,
+            self.stream.hop,
+            overlaps.lags(),
+            |early, late, lag| add_pair(meat, overlaps, early, late, lag, a, two_l),
+        );
         self.windows += 1;
     }
 
@@ -281,20 +153,7 @@ impl ModulatingIdentifier {
     /// errors: the given ones for [`NoiseCompensation::Known`], else the fourth-difference
     /// estimate (0 before five samples).
     pub fn noise_sigmas(&self) -> (f64, f64) {
-        match self.config.noise {
-            NoiseCompensation::Known { sigma_x, sigma_z } => (sigma_x, sigma_z),
-            NoiseCompensation::None | NoiseCompensation::Estimated => {
-                let s = |d: &DifferenceNoise| {
-                    let v = d.sigma();
-                    if v.is_finite() {
-                        v
-                    } else {
-                        0.0
-                    }
-                };
-                (s(&self.noise[0]), s(&self.noise[1]))
-            }
-        }
+        self.stream.noise_sigmas(self.config.noise)
     }
 
     /// The least-squares estimate from every window completed so far (singular, NaN, with
@@ -303,7 +162,7 @@ impl ModulatingIdentifier {
         let half_l = 0.5 * self.window_s();
         let (sx, sz) = self.noise_sigmas();
         let compensate = !matches!(self.config.noise, NoiseCompensation::None);
-        let n0 = self.tf.noise_gram();
+        let n0 = self.stream.tf.noise_gram();
         // unscaling of theta_s = (m (2/L)^2, c (2/L), k)
         let unscale = [half_l * half_l, half_l, 1.0];
         let dir = |d: usize, own: f64, other: f64| {
@@ -312,7 +171,7 @@ impl ModulatingIdentifier {
             } else {
                 0.0
             };
-            let s = self.gram[d].solve(&n0.map(|r| r.map(|v| v * f)));
+            let s = self.gram[d].solve(&n0.map(|r| r.map(|v| v * f)), &[0.0; 3]);
             if s.rcond <= 0.0 {
                 return ModulatingDirection::SINGULAR;
             }
@@ -347,7 +206,7 @@ impl ModulatingIdentifier {
             }
         };
         ModulatingEstimate {
-            t: self.t_window_end,
+            t: self.stream.t_window_end,
             x: dir(0, sx, sz),
             z: dir(1, sz, sx),
             windows: self.windows,
@@ -362,50 +221,16 @@ impl ModulatingIdentifier {
     /// The estimate once every sample is in: [`Self::estimate`], or
     /// [`ModulatingError::RecordShorterThanWindow`] when not one window was completed.
     pub fn finish(&self) -> Result<ModulatingEstimate, ModulatingError> {
-        if self.windows == 0 {
-            return Err(ModulatingError::RecordShorterThanWindow {
-                samples: self.samples() as usize,
-                needed: self.window_samples(),
-                window_s: self.window_s(),
-                dt: self.dt,
-            });
-        }
+        self.stream.require_window(self.windows)?;
         Ok(self.estimate())
     }
 
     /// Restart from nothing (the next measurement is the first; its time may be anything).
     pub fn reset(&mut self) {
-        self.open.clear();
+        self.stream.reset();
         self.closed.clear();
         self.gram = [Gram::default(); 2];
         self.meat = [Meat::default(); 2];
         self.windows = 0;
-        self.t_window_end = f64::NAN;
-        self.noise = [DifferenceNoise::default(); 2];
-        self.n = 0;
-        self.t_prev = f64::NAN;
-    }
-
-    fn validate(&self, m: &Measurement) -> Result<(), InputError> {
-        let s = &m.speed;
-        let fields = [
-            ("t", m.t),
-            ("x", m.x),
-            ("z", m.z),
-            ("phi", s.phi),
-            ("phi_dot", s.omega),
-            ("phi_ddot", s.omega_dot),
-        ];
-        if let Some(&(field, value)) = fields.iter().find(|(_, v)| !v.is_finite()) {
-            return Err(InputError::NotFinite {
-                index: self.n,
-                field,
-                value,
-            });
-        }
-        if self.n > 0 {
-            check_on_time(self.n, m.t, self.t_prev, self.dt)?;
-        }
-        Ok(())
     }
 }

@@ -47,22 +47,41 @@
 //! - [`ModulatingIdentifier`]: streaming (normal equations updated window by window;
 //!   memory independent of the record length).
 //! - [`identify_modulating`], [`identify_modulating_response`]: whole records.
+//!
+//! The cross-coupled rotor (issue 26; docs/method.md section 4.8): per row m and the four
+//! bearing coefficients of that row, from the same window sums, with the noise bias of both
+//! channels (in the regressors and in the right-hand side) compensated and sandwich
+//! standard errors:
+//!
+//! - [`CrossModulatingIdentifier`] (module `cross`): streaming, one
+//!   [`CrossModulatingEstimate`] at the end.
+//! - [`identify_cross_modulating`], [`identify_cross_modulating_response`]: whole records.
 
 mod batch;
 mod config;
+mod cross;
+mod cross_estimate;
+mod cross_uncertainty;
 mod error;
 mod estimate;
 mod identifier;
 pub(crate) mod noise_estimate;
 mod normal_equations;
+mod stream;
 mod test_functions;
 mod uncertainty;
 
-pub use batch::{identify_modulating, identify_modulating_response};
+pub use batch::{
+    identify_cross_modulating, identify_cross_modulating_response, identify_modulating,
+    identify_modulating_response,
+};
 pub use config::{
     ModulatingConfig, NoiseCompensation, DEFAULT_FUNCTIONS, DEFAULT_HOP_FRACTION,
     DEFAULT_MODULATING_RCOND_MIN, DEFAULT_WINDOW_S, MAX_FUNCTIONS, MAX_OVERLAP,
 };
+pub use cross::CrossModulatingIdentifier;
+pub use cross_estimate::{CrossModulatingDirection, CrossModulatingEstimate};
 pub use error::ModulatingError;
 pub use estimate::{ModulatingDirection, ModulatingEstimate};
-pub use identifier::{ModulatingIdentifier, MIN_INTERVALS, MIN_INTERVALS_PER_FUNCTION};
+pub use identifier::ModulatingIdentifier;
+pub use stream::{MIN_INTERVALS, MIN_INTERVALS_PER_FUNCTION};

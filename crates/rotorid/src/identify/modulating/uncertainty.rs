@@ -33,6 +33,8 @@
 //! (noisy) phi_r stand in for the noise-free ones, and terms of order sigma^4 are
 //! neglected: the standard errors are asymptotic (first order), like the CRB.
 
+use std::collections::VecDeque;
+
 use super::test_functions::TestFunctions;
 
 /// Column of the table (psi, psi', psi'') and sign for each unknown (m, c, k): the row is
@@ -82,23 +84,55 @@ impl Overlaps {
         self.lags
     }
 
+    /// Test functions per window.
+    pub(crate) fn functions(&self) -> usize {
+        self.functions
+    }
+
+    /// M(lag hop, i, j): `[a][b]` = sum_k T_i,a(k) T_j,b(k - lag hop), T = (psi, psi',
+    /// psi'') of the early window's function i and the late one's j.
     #[inline]
-    fn get(&self, lag: usize, i: usize, j: usize) -> &[[f64; 3]; 3] {
+    pub(crate) fn get(&self, lag: usize, i: usize, j: usize) -> &[[f64; 3]; 3] {
         &self.m[(lag * self.functions + i) * self.functions + j]
     }
 }
 
-/// A completed window as the covariance needs it.
+/// A completed window as the covariance needs it (P regressors per row).
 #[derive(Debug, Clone)]
-pub(crate) struct ClosedWindow {
+pub(crate) struct ClosedWindow<const P: usize> {
     /// Index of its first sample.
     pub start: u64,
     /// phi of each test function, x rows then z rows.
-    pub phi: [Vec<[f64; 3]>; 2],
+    pub phi: [Vec<[f64; P]>; 2],
     /// w \[rad/s\] at the window's centre.
     pub w: f64,
     /// w' \[rad/s^2\] at the window's centre.
     pub w_dot: f64,
+}
+
+/// Pair the window `done`, just completed, with the completed windows it overlaps: drop
+/// from `closed` those it no longer reaches (starts more than `reach` samples apart), call
+/// `add(early, &done, lag)` for each one within the `lags` tabulated (lag in hops of `hop`
+/// samples), then `add(&done, &done, 0)`, and keep `done` for the windows to come.
+pub(crate) fn pair_overlapping<const P: usize>(
+    closed: &mut VecDeque<ClosedWindow<P>>,
+    done: ClosedWindow<P>,
+    reach: u64,
+    hop: u64,
+    lags: usize,
+    mut add: impl FnMut(&ClosedWindow<P>, &ClosedWindow<P>, usize),
+) {
+    while closed.front().is_some_and(|c| done.start - c.start > reach) {
+        closed.pop_front();
+    }
+    for early in closed.iter() {
+        let lag = ((done.start - early.start) / hop) as usize;
+        if lag < lags {
+            add(early, &done, lag);
+        }
+    }
+    add(&done, &done, 0);
+    closed.push_back(done);
 }
 
 /// The theta-free parts of V for one direction (module docs).
@@ -128,8 +162,8 @@ fn add_outer(acc: &mut [[f64; 3]; 3], c: f64, u: &[f64; 3], v: &[f64; 3], both: 
 pub(crate) fn add_pair(
     meat: &mut [Meat; 2],
     ov: &Overlaps,
-    early: &ClosedWindow,
-    late: &ClosedWindow,
+    early: &ClosedWindow<3>,
+    late: &ClosedWindow<3>,
     lag: usize,
     a: f64,
     two_l: f64,

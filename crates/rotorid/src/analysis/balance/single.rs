@@ -1,4 +1,4 @@
-//! Single-plane balancing, two ways. Angles on the rotor (the unbalance alpha, a trial
+//! Single-plane balancing, two ways (the forms `rotorid balance` had first). Angles on the rotor (the unbalance alpha, a trial
 //! mass, the correction) are shaft angles measured from the keyphasor reference (phi = 0)
 //! in the direction of rotation; an unbalance is the complex number m_u d e^{i angle}
 //! \[kg m\], and masses at one plane add as such numbers.
@@ -28,23 +28,26 @@
 //! ```
 //!
 //! (least squares over both directions; the trial mass is removed before the correction
-//! is fitted). The standard deviations follow from the 1X vectors' covariances (one_x
-//! module; the four vectors independent) by the delta method, the Jacobian of (Re C, Im C)
-//! over the eight real components taken by central differences (C is a smooth rational
-//! function of them; steps of 1e-6 of the largest vector leave ~1e-10 relative error).
+//! is fitted). This is the one-plane, two-sensor, one-speed case of the multi-plane
+//! computation (parent module): the same fit, correction and delta-method standard
+//! deviations, from the four 1X vectors' covariances (one_x module; the vectors
+//! independent).
 //! References: ISO 21940-11 (rigid-rotor balancing); Thearle, "Dynamic balancing of
 //! rotating machinery in the field", Trans. ASME 56, 1934 (influence coefficients);
 //! Lalanne & Ferraris (1998), ch. 7.
 
-use nalgebra::{Complex, Matrix2, SMatrix};
+use nalgebra::{Complex, Matrix2};
+
+use super::data::{MassInput, VectorInput};
+use super::multi::{balance, BalanceOptions};
 
 use crate::model::{check, RotorParams};
 
-use super::covariance::{values, CovarianceParameter, Gradient, ParameterCovariance, NPARAM};
-use super::error::{check_params, check_speed, AnalysisError};
-use super::modes::C64;
-use super::one_x::OneX;
-use super::response::{transfer, wrap, Probe};
+use crate::analysis::covariance::{values, CovarianceParameter, Gradient, ParameterCovariance, NPARAM};
+use crate::analysis::error::{check_params, check_speed, AnalysisError};
+use crate::analysis::modes::C64;
+use crate::analysis::one_x::OneX;
+use crate::analysis::response::{transfer, wrap, Probe};
 
 /// A correction mass at one plane.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,7 +74,7 @@ impl Correction {
 
     /// The correction for the unbalance `c` \[kg m\] at `radius` \[m\], with the covariance
     /// `cov` of (Re c, Im c) \[kg^2 m^2\] when known.
-    fn new(c: C64, radius: f64, cov: Option<Matrix2<f64>>) -> Self {
+    pub(crate) fn new(c: C64, radius: f64, cov: Option<Matrix2<f64>>) -> Self {
         let size = c.norm();
         let angle = if size > 0.0 { wrap(c.arg()) } else { 0.0 };
         let quad = |g: [f64; 2], s: &Matrix2<f64>| {
@@ -203,22 +206,12 @@ pub struct InfluenceBalance {
     pub before: [C64; 2],
 }
 
-/// The least-squares correction unbalance C \[kg m\] for the reference vectors `v0` and
-/// trial vectors `v1` with trial unbalance `t`, or `None` if the trial changed nothing.
-fn correction_unbalance(v0: [C64; 2], v1: [C64; 2], t: C64) -> Option<(C64, [C64; 2])> {
-    let h = [(v1[0] - v0[0]) / t, (v1[1] - v0[1]) / t];
-    let s = h[0].norm_sqr() + h[1].norm_sqr();
-    // NaN fails `s > 0.0`, so a NaN sum is rejected too
-    if !(s.is_finite() && s > 0.0) {
-        return None;
-    }
-    let n = h[0].conj() * v0[0] + h[1].conj() * v0[1];
-    Some((-n / s, h))
-}
-
 /// The correction at `radius` \[m\] (finite, > 0) from a reference run and a trial run
 /// with `trial` added, at the same speed (module doc, (b)); `Ok(None)` when the trial
-/// mass changed neither 1X vector (no influence coefficient).
+/// mass changed neither 1X vector (no influence coefficient). This is the one-plane,
+/// two-sensor, one-speed case of [`balance`](super::balance): the influence coefficients
+/// fitted to the two runs, the least-squares correction of the reference run, and its
+/// standard deviations from the four vectors' covariances.
 pub fn balance_from_runs(
     reference: &RunVectors,
     trial_run: &RunVectors,
@@ -232,53 +225,74 @@ pub fn balance_from_runs(
     })?;
     check("trial angle", trial.angle, "finite (rad)", |_| true)?;
     let t = Complex::from_polar(trial.mass * trial.radius, trial.angle);
-    let runs = [reference.x, reference.z, trial_run.x, trial_run.z];
-    let vecs = |r: &[C64; 4]| ([r[0], r[1]], [r[2], r[3]]);
-    let v: [C64; 4] = runs.map(|o| o.vector);
-    let (v0, v1) = vecs(&v);
-    let Some((c, h)) = correction_unbalance(v0, v1, t) else {
+    let h = [
+        (trial_run.x.vector - reference.x.vector) / t,
+        (trial_run.z.vector - reference.z.vector) / t,
+    ];
+    let s = h[0].norm_sqr() + h[1].norm_sqr();
+    // NaN fails `s > 0.0`, so a NaN sum is rejected too
+    if !(s.is_finite() && s > 0.0) {
         return Ok(None);
-    };
-    // Jacobian of (Re C, Im C) over the 8 real components, by central differences
-    let step = 1e-6 * v.iter().fold(0.0f64, |m, z| m.max(z.norm()));
-    let mut jac = SMatrix::<f64, 2, 8>::zeros();
-    let mut ok = step > 0.0;
-    for k in 0..8 {
-        let bump = |sign: f64| {
-            let mut w = v;
-            let d = if k % 2 == 0 {
-                Complex::new(sign * step, 0.0)
-            } else {
-                Complex::new(0.0, sign * step)
-            };
-            w[k / 2] += d;
-            let (a, b) = vecs(&w);
-            correction_unbalance(a, b, t).map(|(c, _)| c)
-        };
-        match (bump(1.0), bump(-1.0)) {
-            (Some(up), Some(dn)) => {
-                let d = (up - dn) / (2.0 * step);
-                jac[(0, k)] = d.re;
-                jac[(1, k)] = d.im;
-            }
-            _ => ok = false,
+    }
+    let mut vectors = Vec::with_capacity(4);
+    for (run, rv) in [(REFERENCE, reference), (TRIAL, trial_run)] {
+        for (sensor, o) in [("x", rv.x), ("z", rv.z)] {
+            vectors.push(VectorInput {
+                run: run.into(),
+                speed_rpm: 1.0,
+                sensor: sensor.into(),
+                unit: "m".into(),
+                value: o.vector,
+                covariance: Some(o.covariance),
+            });
         }
     }
-    let mut sigma = SMatrix::<f64, 8, 8>::zeros();
-    for (r, o) in runs.iter().enumerate() {
-        sigma
-            .fixed_view_mut::<2, 2>(2 * r, 2 * r)
-            .copy_from(&o.covariance);
-    }
-    let cov = ok.then(|| jac * sigma * jac.transpose());
-    let cov = cov.filter(|c| c.iter().all(|v| v.is_finite()));
+    let masses = [
+        MassInput {
+            run: REFERENCE.into(),
+            plane: PLANE.into(),
+            mass: 0.0,
+            radius: trial.radius,
+            angle: 0.0,
+        },
+        MassInput {
+            run: TRIAL.into(),
+            plane: PLANE.into(),
+            mass: trial.mass,
+            radius: trial.radius,
+            angle: trial.angle,
+        },
+    ];
+    let opts = BalanceOptions {
+        current: REFERENCE.into(),
+        default_radius: Some(radius),
+        ..BalanceOptions::default()
+    };
+    let b = balance(&vectors, &masses, &opts)?;
+    let fit = |sensor: usize| {
+        b.fits
+            .iter()
+            .find(|k| k.sensor == sensor)
+            .map_or(h[sensor], |k| k.fit.h[0])
+    };
+    let residual = |sensor: usize| {
+        b.residual
+            .iter()
+            .find(|r| r.sensor == sensor)
+            .map_or(Complex::new(f64::NAN, f64::NAN), |r| r.after)
+    };
     Ok(Some(InfluenceBalance {
-        correction: Correction::new(c, radius, cov),
-        influence: h,
-        residual: [v0[0] + h[0] * c, v0[1] + h[1] * c],
-        before: v0,
+        correction: b.corrections[0].correction,
+        influence: [fit(0), fit(1)],
+        residual: [residual(0), residual(1)],
+        before: [reference.x.vector, reference.z.vector],
     }))
 }
+
+/// The run names, plane and speed of [`balance_from_runs`] as a multi-plane problem.
+const REFERENCE: &str = "reference";
+const TRIAL: &str = "trial";
+const PLANE: &str = "1";
 
 #[cfg(test)]
 mod tests {
