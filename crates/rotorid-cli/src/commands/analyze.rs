@@ -1,4 +1,5 @@
-//! `rotorid analyze (SUMMARY.json | --scenario S.toml) --out DIR [--rpm 0:6000:10]`:
+//! `rotorid analyze (SUMMARY.json | --scenario S.toml) --out DIR [--rpm 0:6000:10]
+//! [--operating-rpm RPM]`:
 //! from identified (or stated) rotor parameters to the numbers an engineer decides on,
 //! with the uncertainty of the identification carried through (`rotorid::analysis`).
 //!
@@ -12,15 +13,23 @@
 //! ```json
 //! {
 //!   "format_version": 1, "generator": "rotorid analyze 0.1.0", "source": "s.json",
+//!   "model": "jeffcott",                          // or "cross_coupled"
 //!   "rotor": {"m": .., "cx": .., "kx": .., "cz": .., "kz": .., "a": .., "mud": .., "alpha": ..},
+//!            // cross_coupled: m, cxx, cxz, czx, czz, kxx, kxz, kzx, kzz, a, mud, alpha
 //!   "rotor_std": {"m": .., ...} | null,          // null entries: undetermined
 //!   "speed_range_rpm": {"start": 0, "stop": 6000, "step": 10},
 //!   "critical_speeds": [{"rpm": 2519.9, "whirl": "backward", "std_rpm": 0.3, "mode": 0,
-//!                        "frequency_hz": 42.0, "damping_ratio": .., "log_dec": ..}],
+//!                        "frequency_hz": 42.0, "damping_ratio": .., "log_dec": ..,
+//!                        "log_dec_std": ..}],
 //!   "campbell": {"rpm": [...], "modes": [{"whirl": "backward", "frequency_hz": [...],
 //!                "log_dec": [...], "damping_ratio": [...], "whirl_by_speed": [...]}]},
 //!   "stability": {"stable": true, "min_log_dec": .., "min_log_dec_rpm": .., "min_log_dec_mode": 1,
-//!                 "min_damping_ratio": .., "threshold_rpm": null},
+//!                 "min_damping_ratio": .., "threshold_rpm": null, "threshold_rpm_std": null,
+//!                 "threshold_mode": null, "threshold_whirl": null, "unstable_at_start": false,
+//!                 "stable_from_rpm": null, "stable_from_rpm_std": null,
+//!                 "operating": {"rpm": 1200, "source": "given", "mode": 1, "whirl": "forward",
+//!                               "frequency_hz": .., "damping_ratio": .., "log_dec": ..,
+//!                               "log_dec_std": .., "stable": true} | null},
 //!   "unbalance_response": {"rpm": [...], "amplitude_unit": "um pk-pk", "band_sigmas": 2,
 //!                "channels": [{"name": "x", "probe_deg": 90, "amplitude_um_pp": [...],
 //!                "std_amplitude_um_pp": [...], "phase_lag_deg": [...], "std_phase_lag_deg": [...],
@@ -36,15 +45,27 @@
 //! grid refined around each critical speed (the resonances are sharper than 10 rpm), so
 //! its `rpm` array is not the Campbell diagram's. Standard deviations are linearised from
 //! the summary's covariance (null without one, or where a parameter is undetermined).
+//!
+//! Stability (`rotorid::analysis` stability module, docs/analysis.md section 4): the
+//! threshold is the lowest speed of the range at which the least damped mode's logarithmic
+//! decrement turns negative (`threshold_rpm`, null when stable over the whole range; the
+//! first speed of the range with `unstable_at_start` when already unstable there), with
+//! its standard deviation by the implicit function theorem, the mode and its whirl;
+//! `stable_from_rpm`, after an instability, where the rotor is stable again to the end of
+//! the range. `operating` is the stability margin, the least damped mode's logarithmic
+//! decrement with its standard deviation, at `--operating-rpm` (source `given`) or at the
+//! constant speed of a `--scenario` (source `scenario`); null otherwise.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context};
 use rotorid::analysis::{
-    campbell, critical_speeds, stability, unbalance_response, Campbell, CovarianceParameter,
-    CriticalSpeed, ParameterCovariance, Probe, Stability, UnbalanceResponse, Whirl,
+    campbell, critical_speeds, stability_margin, stability_with_covariance, unbalance_response,
+    Campbell, CovarianceParameter, CriticalSpeed, ParameterCovariance, Probe, Stability,
+    StabilityMargin, UnbalanceResponse, Whirl,
 };
-use rotorid::model::{rad_per_s_to_rpm, rpm_to_rad_per_s};
+use rotorid::model::{rad_per_s_to_rpm, rpm_to_rad_per_s, CrossCoupling, SpeedProfile};
+use rotorid::parameter::ModelKind;
 use rotorid::{RotorParams, Unbalance};
 use serde::Serialize;
 
@@ -112,6 +133,12 @@ pub struct AnalyzeArgs {
     /// (vertical) in the direction of rotation (repeatable; x and z are always shown).
     #[arg(long = "probe", value_name = "DEG", allow_hyphen_values = true)]
     pub probes: Vec<f64>,
+
+    /// The operating speed in rpm: the stability margin (least damped mode's logarithmic
+    /// decrement with its standard deviation) is reported there. Default: a scenario's
+    /// constant speed; none for a summary.
+    #[arg(long, value_name = "RPM", value_parser = parse_operating_rpm)]
+    pub operating_rpm: Option<f64>,
 
     /// Amplitude unit of the figures: um or mil peak-to-peak (analysis.json is in um).
     #[arg(long, value_enum, default_value_t = AmplitudeUnit::Um)]
@@ -209,6 +236,15 @@ pub fn parse_rpm_grid(s: &str) -> Result<RpmGrid, String> {
     Ok(RpmGrid { start, stop, step })
 }
 
+/// Parse `--operating-rpm`: a finite speed >= 0 (rpm).
+pub fn parse_operating_rpm(s: &str) -> Result<f64, String> {
+    s.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| format!("`{s}` is not a speed: expected a finite number >= 0 (rpm)"))
+}
+
 /// The rotor to analyse: from a summary (with its covariance) or a scenario; and a
 /// description of where it came from.
 pub fn load_rotor(
@@ -216,8 +252,17 @@ pub fn load_rotor(
     scenario: Option<&str>,
     who: &str,
 ) -> anyhow::Result<(IdentifiedRotor, String)> {
+    load_rotor_and_speed(summary, scenario, who).map(|(r, s, _)| (r, s))
+}
+
+/// [`load_rotor`], and the scenario's constant speed \[rad/s\] when it has one.
+fn load_rotor_and_speed(
+    summary: Option<&Path>,
+    scenario: Option<&str>,
+    who: &str,
+) -> anyhow::Result<(IdentifiedRotor, String, Option<f64>)> {
     match (summary, scenario) {
-        (Some(p), _) => Ok((IdentifiedRotor::read(p)?, p.display().to_string())),
+        (Some(p), _) => Ok((IdentifiedRotor::read(p)?, p.display().to_string(), None)),
         (None, Some(s)) => {
             let spec = ScenarioSpec::load(s)?;
             let id = spec.identification()?;
@@ -230,13 +275,24 @@ pub fn load_rotor(
                     )
                 })
             };
+            let coupling = match id.model {
+                ModelKind::Jeffcott => None,
+                ModelKind::CrossCoupled => Some(CrossCoupling {
+                    cxz: need(t.cxz, "cxz", "N s/m")?,
+                    czx: need(t.czx, "czx", "N s/m")?,
+                    kxz: need(t.kxz, "kxz", "N/m")?,
+                    kzx: need(t.kzx, "kzx", "N/m")?,
+                }),
+            };
+            let cross = coupling.is_some();
+            let name = |j: &'static str, c: &'static str| if cross { c } else { j };
             let params = RotorParams {
-                coupling: None,
+                coupling,
                 m: need(t.m, "m", "kg")?,
-                cx: need(t.cx, "cx", "N s/m")?,
-                cz: need(t.cz, "cz", "N s/m")?,
-                kx: need(t.kx, "kx", "N/m")?,
-                kz: need(t.kz, "kz", "N/m")?,
+                cx: need(t.cx, name("cx", "cxx"), "N s/m")?,
+                cz: need(t.cz, name("cz", "czz"), "N s/m")?,
+                kx: need(t.kx, name("kx", "kxx"), "N/m")?,
+                kz: need(t.kz, name("kz", "kzz"), "N/m")?,
                 a: id.a,
                 unbalance: Unbalance {
                     m_u: id.m_u,
@@ -244,12 +300,17 @@ pub fn load_rotor(
                     alpha: id.alpha,
                 },
             };
+            let speed = match id.speed {
+                Some(SpeedProfile::Constant { omega, .. }) => Some(omega),
+                _ => None,
+            };
             Ok((
                 IdentifiedRotor {
                     params,
                     covariance: None,
                 },
                 format!("scenario {}", spec.origin()),
+                speed,
             ))
         }
         (None, None) => bail!("give an identification summary SUMMARY.json or --scenario"),
@@ -293,6 +354,31 @@ struct RotorJson {
     alpha: f64,
 }
 
+/// The cross-coupled model's rotor, keyed as the summary keys it.
+#[derive(Serialize)]
+struct CrossRotorJson<T> {
+    m: T,
+    cxx: T,
+    cxz: T,
+    czx: T,
+    czz: T,
+    kxx: T,
+    kxz: T,
+    kzx: T,
+    kzz: T,
+    a: T,
+    mud: T,
+    alpha: T,
+}
+
+/// The rotor (or its standard deviations) in the model's own names.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum ModelRotorJson<J, C> {
+    Jeffcott(J),
+    Cross(C),
+}
+
 #[derive(Serialize)]
 struct RotorStdJson {
     m: Option<f64>,
@@ -314,6 +400,7 @@ struct CriticalJson {
     frequency_hz: f64,
     damping_ratio: f64,
     log_dec: Option<f64>,
+    log_dec_std: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -339,6 +426,27 @@ struct StabilityJson {
     min_log_dec_mode: Option<usize>,
     min_damping_ratio: f64,
     threshold_rpm: Option<f64>,
+    threshold_rpm_std: Option<f64>,
+    threshold_mode: Option<usize>,
+    threshold_whirl: Option<Whirl>,
+    unstable_at_start: bool,
+    stable_from_rpm: Option<f64>,
+    stable_from_rpm_std: Option<f64>,
+    operating: Option<OperatingJson>,
+}
+
+/// The stability margin at the operating speed.
+#[derive(Serialize)]
+struct OperatingJson {
+    rpm: f64,
+    source: &'static str,
+    mode: usize,
+    whirl: Option<Whirl>,
+    frequency_hz: f64,
+    damping_ratio: f64,
+    log_dec: Option<f64>,
+    log_dec_std: Option<f64>,
+    stable: bool,
 }
 
 #[derive(Serialize)]
@@ -371,8 +479,9 @@ struct AnalysisJson {
     format_version: u32,
     generator: String,
     source: String,
-    rotor: RotorJson,
-    rotor_std: Option<RotorStdJson>,
+    model: &'static str,
+    rotor: ModelRotorJson<RotorJson, CrossRotorJson<f64>>,
+    rotor_std: Option<ModelRotorJson<RotorStdJson, CrossRotorJson<Option<f64>>>>,
     speed_range_rpm: RpmGrid,
     critical_speeds: Vec<CriticalJson>,
     campbell: CampbellJson,
@@ -388,11 +497,38 @@ struct Results {
     campbell: Campbell,
     critical: Vec<CriticalSpeed>,
     stability: Stability,
+    /// The margin at the operating speed, and where that speed came from.
+    operating: Option<(StabilityMargin, &'static str)>,
     response: UnbalanceResponse,
     names: Vec<String>,
 }
 
-fn rotor_std(p: &RotorParams, c: &ParameterCovariance) -> RotorStdJson {
+fn rotor_std(
+    p: &RotorParams,
+    c: &ParameterCovariance,
+) -> ModelRotorJson<RotorStdJson, CrossRotorJson<Option<f64>>> {
+    let j = jeffcott_std(p, c);
+    if p.coupling.is_none() {
+        return ModelRotorJson::Jeffcott(j);
+    }
+    let one = |q: CovarianceParameter| c.std(q);
+    ModelRotorJson::Cross(CrossRotorJson {
+        m: j.m,
+        cxx: j.cx,
+        cxz: one(CovarianceParameter::Cxz),
+        czx: one(CovarianceParameter::Czx),
+        czz: j.cz,
+        kxx: j.kx,
+        kxz: one(CovarianceParameter::Kxz),
+        kzx: one(CovarianceParameter::Kzx),
+        kzz: j.kz,
+        a: j.a,
+        mud: j.mud,
+        alpha: j.alpha,
+    })
+}
+
+fn jeffcott_std(p: &RotorParams, c: &ParameterCovariance) -> RotorStdJson {
     let (mud, alpha) = (p.unbalance.mud(), p.unbalance.alpha);
     let (s, co) = alpha.sin_cos();
     let one = |q: CovarianceParameter| c.std(q);
@@ -434,7 +570,11 @@ fn probes(extra: &[f64]) -> anyhow::Result<(Vec<Probe>, Vec<String>)> {
     Ok((p, names))
 }
 
-fn compute(args: &AnalyzeArgs, rotor: IdentifiedRotor) -> anyhow::Result<Results> {
+fn compute(
+    args: &AnalyzeArgs,
+    rotor: IdentifiedRotor,
+    scenario_speed: Option<f64>,
+) -> anyhow::Result<Results> {
     let speeds: Vec<f64> = args
         .rpm
         .speeds_rpm()
@@ -449,7 +589,15 @@ fn compute(args: &AnalyzeArgs, rotor: IdentifiedRotor) -> anyhow::Result<Results
     } else {
         Vec::new()
     };
-    let stab = stability(&p, &speeds)?;
+    let stab = stability_with_covariance(&p, cov, &speeds)?;
+    let operating = match (args.operating_rpm, scenario_speed) {
+        (Some(rpm), _) => Some((rpm_to_rad_per_s(rpm), "given")),
+        (None, Some(w)) => Some((w, "scenario")),
+        (None, None) => None,
+    };
+    let operating = operating
+        .map(|(w, src)| stability_margin(&p, cov, w).map(|m| (m, src)))
+        .transpose()?;
     let (pr, names) = probes(&args.probes)?;
     let response = unbalance_response(&p, cov, &response_grid(&speeds, &critical), &pr)?;
     Ok(Results {
@@ -458,6 +606,7 @@ fn compute(args: &AnalyzeArgs, rotor: IdentifiedRotor) -> anyhow::Result<Results
         campbell: camp,
         critical,
         stability: stab,
+        operating,
         response,
         names,
     })
@@ -467,10 +616,58 @@ fn whirl_name(w: Option<Whirl>) -> &'static str {
     w.map_or("no whirl direction", Whirl::name)
 }
 
+/// `v` with 4 (`digits`) decimals and its standard deviation when there is one.
+fn with_std_fixed(v: f64, std: Option<f64>, digits: usize) -> String {
+    match std {
+        Some(s) => format!("{v:.digits$} \u{b1} {s:.digits$}"),
+        None => format!("{v:.digits$}"),
+    }
+}
+
+/// The instability in words: where it starts (with its standard deviation), the mode and
+/// whirl that grow, where the rotor is stable again, and what causes it.
+fn instability_text(st: &Stability, cross: bool) -> String {
+    let Some(t) = st.threshold else {
+        return "stable over the range".to_string();
+    };
+    let whirl = st
+        .threshold_whirl
+        .map_or("a".to_string(), |w| format!("the {}", w.name()));
+    let mode = ["lower", "higher"][st.threshold_mode.unwrap_or(0).min(1)];
+    let mut s = if st.unstable_at_start {
+        format!(
+            "UNSTABLE from the start of the range ({:.1} rpm): {whirl} whirl ({mode}) mode's log decrement is negative",
+            rad_per_s_to_rpm(t)
+        )
+    } else {
+        format!(
+            "UNSTABLE above the threshold speed {}: {whirl} whirl ({mode}) mode's log decrement turns negative there",
+            with_std(rad_per_s_to_rpm(t), st.threshold_std_rpm(), "rpm")
+        )
+    };
+    if let Some(w) = st.stable_from {
+        s.push_str(&format!(
+            "; stable again from {}",
+            with_std(
+                rad_per_s_to_rpm(w),
+                st.stable_from_std.map(rad_per_s_to_rpm),
+                "rpm"
+            )
+        ));
+    }
+    s.push_str(if cross {
+        " (the bearings' cross-coupled coefficients feed that whirl faster than the damping dissipates it)"
+    } else {
+        " (the Jeffcott rotor is stable whenever cx, cz > 0: check the identified damping)"
+    });
+    s
+}
+
 /// Run `rotorid analyze`.
 pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
-    let (rotor, source) = load_rotor(args.summary.as_deref(), args.scenario.as_deref(), "analyze")?;
-    let r = compute(&args, rotor)?;
+    let (rotor, source, scenario_speed) =
+        load_rotor_and_speed(args.summary.as_deref(), args.scenario.as_deref(), "analyze")?;
+    let r = compute(&args, rotor, scenario_speed)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
 
@@ -513,20 +710,47 @@ pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
             n + 1,
             with_std(c.rpm(), c.std_rpm(), "rpm"),
             whirl_name(c.whirl()),
-            c.at.log_dec.map_or("-".into(), |d| format!("{d:.4}"))
+            c.at.log_dec
+                .map_or("-".into(), |d| with_std_fixed(d, c.log_dec_std, 4))
         )?;
     }
-    match (r.stability.threshold, r.stability.min_log_dec) {
+    let st = &r.stability;
+    match (st.threshold, st.min_log_dec) {
         (None, Some(d)) => outln!(
             "stability: stable over the range; minimum log decrement {d:.4} ({} mode at {:.0} rpm)",
-            ["lower", "higher"][r.stability.min_log_dec_mode.unwrap_or(0).min(1)],
-            rad_per_s_to_rpm(r.stability.min_log_dec_speed.unwrap_or(0.0))
+            ["lower", "higher"][st.min_log_dec_mode.unwrap_or(0).min(1)],
+            rad_per_s_to_rpm(st.min_log_dec_speed.unwrap_or(0.0))
         )?,
         (None, None) => outln!("stability: stable over the range")?,
-        (Some(t), _) => outln!(
-            "stability: UNSTABLE from {:.1} rpm (a mode's log decrement is negative; the model is stable whenever cx, cz > 0)",
-            rad_per_s_to_rpm(t)
-        )?,
+        (Some(_), _) => {
+            let text = instability_text(st, r.params.coupling.is_some());
+            outln!("stability: {text}")?;
+            eprintln!("warning: {text}");
+        }
+    }
+    if let Some((m, src)) = &r.operating {
+        let rpm = rad_per_s_to_rpm(m.speed);
+        let from = if *src == "given" {
+            "--operating-rpm"
+        } else {
+            "the scenario's speed"
+        };
+        let d = m
+            .log_dec()
+            .map_or("- (the mode does not oscillate)".into(), |d| {
+                with_std_fixed(d, m.log_dec_std, 4)
+            });
+        outln!(
+            "stability margin at {rpm:.1} rpm ({from}): log decrement {d} of the least damped mode ({} mode, {})",
+            ["lower", "higher"][m.mode.min(1)],
+            whirl_name(m.at.whirl)
+        )?;
+        if m.is_unstable() {
+            eprintln!(
+                "warning: the rotor is UNSTABLE at the operating speed {rpm:.1} rpm: the {} mode's log decrement is {d}",
+                whirl_name(m.at.whirl)
+            );
+        }
     }
     outln!(
         "wrote {}: analysis.json, {}, report.html",
@@ -722,15 +946,32 @@ fn analysis_json(
         format_version: ANALYSIS_FORMAT_VERSION,
         generator: format!("rotorid analyze {}", env!("CARGO_PKG_VERSION")),
         source: source.to_string(),
-        rotor: RotorJson {
-            m: p.m,
-            cx: p.cx,
-            kx: p.kx,
-            cz: p.cz,
-            kz: p.kz,
-            a: p.a,
-            mud: p.unbalance.mud(),
-            alpha: p.unbalance.alpha,
+        model: p.model().name(),
+        rotor: match p.coupling {
+            None => ModelRotorJson::Jeffcott(RotorJson {
+                m: p.m,
+                cx: p.cx,
+                kx: p.kx,
+                cz: p.cz,
+                kz: p.kz,
+                a: p.a,
+                mud: p.unbalance.mud(),
+                alpha: p.unbalance.alpha,
+            }),
+            Some(x) => ModelRotorJson::Cross(CrossRotorJson {
+                m: p.m,
+                cxx: p.cx,
+                cxz: x.cxz,
+                czx: x.czx,
+                czz: p.cz,
+                kxx: p.kx,
+                kxz: x.kxz,
+                kzx: x.kzx,
+                kzz: p.kz,
+                a: p.a,
+                mud: p.unbalance.mud(),
+                alpha: p.unbalance.alpha,
+            }),
         },
         rotor_std: r.covariance.as_ref().map(|c| rotor_std(p, c)),
         speed_range_rpm: args.rpm,
@@ -745,6 +986,7 @@ fn analysis_json(
                 frequency_hz: c.at.frequency_hz(),
                 damping_ratio: c.at.damping_ratio,
                 log_dec: c.at.log_dec,
+                log_dec_std: c.log_dec_std,
             })
             .collect(),
         campbell: CampbellJson {
@@ -770,7 +1012,24 @@ fn analysis_json(
             min_log_dec_rpm: r.stability.min_log_dec_speed.map(rad_per_s_to_rpm),
             min_log_dec_mode: r.stability.min_log_dec_mode,
             min_damping_ratio: r.stability.min_damping_ratio,
-            threshold_rpm: r.stability.threshold.map(rad_per_s_to_rpm),
+            threshold_rpm: r.stability.threshold_rpm(),
+            threshold_rpm_std: r.stability.threshold_std_rpm(),
+            threshold_mode: r.stability.threshold_mode,
+            threshold_whirl: r.stability.threshold_whirl,
+            unstable_at_start: r.stability.unstable_at_start,
+            stable_from_rpm: r.stability.stable_from.map(rad_per_s_to_rpm),
+            stable_from_rpm_std: r.stability.stable_from_std.map(rad_per_s_to_rpm),
+            operating: r.operating.as_ref().map(|(m, src)| OperatingJson {
+                rpm: rad_per_s_to_rpm(m.speed),
+                source: src,
+                mode: m.mode,
+                whirl: m.at.whirl,
+                frequency_hz: m.at.frequency_hz(),
+                damping_ratio: m.at.damping_ratio,
+                log_dec: m.at.log_dec,
+                log_dec_std: m.log_dec_std,
+                stable: !m.is_unstable(),
+            }),
         },
         unbalance_response: ResponseJson {
             rpm: r

@@ -10,11 +10,16 @@
 //! }
 //! ```
 //!
-//! - `rotor`: every parameter a finite number in SI units: m \[kg\], cx, cz \[N s/m\], kx, kz
-//!   \[N/m\], a \[N s^2/m\], mud = m_u d \[kg m\], alpha \[rad\] (shaft angle of the unbalance
-//!   from the keyphasor reference in the direction of rotation).
+//! - `model` (schema 3): `jeffcott` (the default when absent, as in schema 2 files) or
+//!   `cross_coupled`.
+//! - `rotor`: every parameter of the model a finite number in SI units: m \[kg\], cx, cz
+//!   \[N s/m\], kx, kz \[N/m\], a \[N s^2/m\], mud = m_u d \[kg m\], alpha \[rad\] (shaft angle
+//!   of the unbalance from the keyphasor reference in the direction of rotation); the
+//!   cross-coupled model names the bearing coefficients cxx, cxz, czx, czz \[N s/m\] and
+//!   kxx, kxz, kzx, kzz \[N/m\] (docs/method.md section 1.6).
 //! - `covariance`: the covariance of the identified parameters, names from `m, cx, kx, cz,
-//!   kz, a, mud_cos_alpha, mud_sin_alpha` (mud_cos_alpha = m_u d cos(alpha), likewise sin),
+//!   kz, a, mud_cos_alpha, mud_sin_alpha` (mud_cos_alpha = m_u d cos(alpha), likewise sin)
+//!   and the cross-coupled model's `cxx, cxz, czx, czz, kxx, kxz, kzx, kzz`,
 //!   one row and one column per name, SI units squared; a JSON `null` entry is infinite
 //!   (an undetermined parameter). `null` for the whole field: no uncertainty is available.
 //!
@@ -24,16 +29,34 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Context};
 use rotorid::analysis::ParameterCovariance;
+use rotorid::model::CrossCoupling;
+use rotorid::parameter::ModelKind;
 use rotorid::{RotorParams, Unbalance};
 use serde_json::Value;
 
 /// The rotor parameters in `rotor`, in order, with their units.
-const ROTOR_FIELDS: [(&str, &str); 8] = [
+pub(crate) const ROTOR_FIELDS: [(&str, &str); 8] = [
     ("m", "kg"),
     ("cx", "N s/m"),
     ("kx", "N/m"),
     ("cz", "N s/m"),
     ("kz", "N/m"),
+    ("a", "N s^2/m"),
+    ("mud", "kg m"),
+    ("alpha", "rad"),
+];
+
+/// The cross-coupled model's `rotor` fields, in the summary's order.
+pub(crate) const CROSS_ROTOR_FIELDS: [(&str, &str); 12] = [
+    ("m", "kg"),
+    ("cxx", "N s/m"),
+    ("cxz", "N s/m"),
+    ("czx", "N s/m"),
+    ("czz", "N s/m"),
+    ("kxx", "N/m"),
+    ("kxz", "N/m"),
+    ("kzx", "N/m"),
+    ("kzz", "N/m"),
     ("a", "N s^2/m"),
     ("mud", "kg m"),
     ("alpha", "rad"),
@@ -63,26 +86,54 @@ impl IdentifiedRotor {
         let Some(top) = doc.as_object() else {
             bail!("{file}: expected a JSON object (an identification summary)");
         };
-        let rotor = top.get("rotor").ok_or_else(|| {
-            anyhow!(
-                "{file}: missing field `rotor` (the identified m, cx, kx, cz, kz, a, mud, alpha)"
-            )
-        })?;
-        let Some(rotor) = rotor.as_object() else {
-            bail!("{file}: field `rotor` must be an object with m, cx, kx, cz, kz, a, mud, alpha");
+        let model = match top.get("model") {
+            None | Some(Value::Null) => ModelKind::Jeffcott,
+            Some(v) => ModelKind::ALL
+                .into_iter()
+                .find(|k| v.as_str() == Some(k.name()))
+                .ok_or_else(|| {
+                    anyhow!("{file}: field `model` must be \"jeffcott\" or \"cross_coupled\", found {v}")
+                })?,
         };
-        let mut v = [0.0; 8];
-        for (slot, (name, unit)) in v.iter_mut().zip(ROTOR_FIELDS) {
-            let x = rotor
-                .get(name)
-                .ok_or_else(|| anyhow!("{file}: missing field `rotor.{name}` ({unit})"))?;
-            *slot = x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
-                anyhow!("{file}: field `rotor.{name}` must be a finite number ({unit}), found {x}")
+        let fields: &[(&str, &str)] = match model {
+            ModelKind::Jeffcott => &ROTOR_FIELDS,
+            ModelKind::CrossCoupled => &CROSS_ROTOR_FIELDS,
+        };
+        let list = fields.iter().map(|f| f.0).collect::<Vec<_>>().join(", ");
+        let rotor = top
+            .get("rotor")
+            .ok_or_else(|| anyhow!("{file}: missing field `rotor` (the identified {list})"))?;
+        let Some(rotor) = rotor.as_object() else {
+            bail!("{file}: field `rotor` must be an object with {list}");
+        };
+        let mut v = Vec::with_capacity(fields.len());
+        for (name, unit) in fields {
+            let x = rotor.get(*name).ok_or_else(|| match model {
+                ModelKind::Jeffcott => anyhow!("{file}: missing field `rotor.{name}` ({unit})"),
+                ModelKind::CrossCoupled => anyhow!(
+                    "{file}: missing field `rotor.{name}` ({unit}; the cross-coupled model's rotor has {list})"
+                ),
             })?;
+            v.push(x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
+                anyhow!("{file}: field `rotor.{name}` must be a finite number ({unit}), found {x}")
+            })?);
         }
+        let (coupling, v) = match model {
+            ModelKind::Jeffcott => (None, [v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]]),
+            // m, cxx, cxz, czx, czz, kxx, kxz, kzx, kzz, a, mud, alpha
+            ModelKind::CrossCoupled => (
+                Some(CrossCoupling {
+                    cxz: v[2],
+                    czx: v[3],
+                    kxz: v[6],
+                    kzx: v[7],
+                }),
+                [v[0], v[1], v[5], v[4], v[8], v[9], v[10], v[11]],
+            ),
+        };
         let [m, cx, kx, cz, kz, a, mud, alpha] = v;
         let params = RotorParams {
-            coupling: None,
+            coupling,
             m,
             cx,
             cz,
@@ -205,5 +256,42 @@ mod tests {
         let bad_name = GOOD.replace(r#""kx", "a"]"#, r#""k", "a"]"#);
         let e = IdentifiedRotor::parse("s.json", &bad_name).unwrap_err();
         assert!(e.to_string().contains("unknown parameter \"k\""), "{e}");
+    }
+
+    #[test]
+    fn reads_a_cross_coupled_rotor_by_its_model_names() {
+        let text = r#"{"model": "cross_coupled",
+            "rotor": {"m": 14.29, "cxx": 200, "cxz": 20, "czx": -5, "czz": 180, "kxx": 1.195e6,
+                      "kxz": -3e4, "kzx": 4e4, "kzz": 1.4e6, "a": 2.871, "mud": 1.5e-5, "alpha": 0.5},
+            "covariance": {"names": ["m", "kxx", "kxz", "kzx"],
+                           "matrix": [[1e-6, 0, 0, 0], [0, 4e4, 0, 0], [0, 0, 9e4, 0], [0, 0, 0, 1.6e5]]}}"#;
+        let r = IdentifiedRotor::parse("c.json", text).unwrap();
+        let p = r.params;
+        assert_eq!(
+            (p.m, p.cx, p.cz, p.kx, p.kz),
+            (14.29, 200.0, 180.0, 1.195e6, 1.4e6)
+        );
+        assert_eq!(
+            p.coupling,
+            Some(CrossCoupling {
+                cxz: 20.0,
+                czx: -5.0,
+                kxz: -3e4,
+                kzx: 4e4
+            })
+        );
+        let c = r.covariance.unwrap();
+        use rotorid::analysis::CovarianceParameter as P;
+        assert_eq!(c.std(P::Kx), Some(200.0));
+        assert_eq!(c.std(P::Kzx), Some(400.0));
+        let e = IdentifiedRotor::parse("c.json", &text.replace(r#""kzx": 4e4,"#, "")).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("c.json: missing field `rotor.kzx` (N/m; the cross-coupled model's rotor has m, cxx"),
+            "{e}"
+        );
+        let e = IdentifiedRotor::parse("c.json", &text.replace("cross_coupled", "jeffcot"))
+            .unwrap_err();
+        assert!(e.to_string().contains("field `model` must be"), "{e}");
     }
 }

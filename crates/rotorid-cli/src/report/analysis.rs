@@ -12,6 +12,7 @@ use minijinja::Environment;
 use serde::Serialize;
 use serde_json::Value;
 
+use crate::io::identified::{CROSS_ROTOR_FIELDS, ROTOR_FIELDS};
 use crate::io::number::format_sig as fmt_sig;
 use crate::plot::campbell::with_std;
 
@@ -108,28 +109,35 @@ pub fn render_report(
             },
         }
     };
-    let rotor = [
-        ("m", "kg"),
-        ("cx", "N s/m"),
-        ("kx", "N/m"),
-        ("cz", "N s/m"),
-        ("kz", "N/m"),
-        ("a", "N s\u{b2}/m"),
-        ("mud", "kg m"),
-        ("alpha", "rad"),
-    ]
-    .into_iter()
-    .map(|(name, unit)| RotorRow {
-        name,
-        value: num(&a["rotor"][name]).map_or("-".into(), |v| fmt_sig(v, 7)),
-        std: if a["rotor_std"].is_null() {
-            "-".into()
-        } else {
-            std_of(name)
-        },
-        unit,
-    })
-    .collect();
+    let cross = a["model"].as_str() == Some("cross_coupled");
+    let rows: &[(&str, &str)] = if cross {
+        &CROSS_ROTOR_FIELDS
+    } else {
+        &ROTOR_FIELDS
+    };
+    let rotor = rows
+        .iter()
+        .map(|&(name, unit)| {
+            (
+                name,
+                if unit == "N s^2/m" {
+                    "N s\u{b2}/m"
+                } else {
+                    unit
+                },
+            )
+        })
+        .map(|(name, unit)| RotorRow {
+            name,
+            value: num(&a["rotor"][name]).map_or("-".into(), |v| fmt_sig(v, 7)),
+            std: if a["rotor_std"].is_null() {
+                "-".into()
+            } else {
+                std_of(name)
+            },
+            unit,
+        })
+        .collect();
     let critical = a["critical_speeds"]
         .as_array()
         .map(|cs| {
@@ -148,11 +156,36 @@ pub fn render_report(
         .unwrap_or_default();
     let s = &a["stability"];
     let stable = s["stable"].as_bool().unwrap_or(true);
-    let stability = match (num(&s["threshold_rpm"]), num(&s["min_log_dec"])) {
-        (Some(t), _) => format!(
-            "Unstable from {t:.1} rpm: a mode's logarithmic decrement is negative (this model \
-             is stable at every speed when cx and cz are positive: check the identified damping)."
-        ),
+    let mut stability = match (num(&s["threshold_rpm"]), num(&s["min_log_dec"])) {
+        (Some(t), _) => {
+            let whirl = s["threshold_whirl"]
+                .as_str()
+                .map_or("A".to_string(), |w| format!("The {w}"));
+            let at = if s["unstable_at_start"].as_bool() == Some(true) {
+                format!("Unstable from the start of the range ({t:.1} rpm)")
+            } else {
+                format!(
+                    "Unstable above the threshold speed {} rpm",
+                    with_std(t, num(&s["threshold_rpm_std"]), "")
+                )
+            };
+            let again = num(&s["stable_from_rpm"]).map_or(String::new(), |w| {
+                format!(
+                    "; stable again from {} rpm",
+                    with_std(w, num(&s["stable_from_rpm_std"]), "")
+                )
+            });
+            let cause = if cross {
+                "the bearings' cross-coupled coefficients feed that whirl faster than the \
+                 damping dissipates it"
+            } else {
+                "the Jeffcott rotor is stable at every speed when cx and cz are positive: check \
+                 the identified damping"
+            };
+            format!(
+                "{at}{again}: {whirl} whirl mode's logarithmic decrement is negative ({cause})."
+            )
+        }
         (None, Some(d)) => format!(
             "Stable over the whole range. Smallest logarithmic decrement {} ({} mode at {:.0} rpm).",
             fmt_sig(d, 4),
@@ -161,6 +194,23 @@ pub fn render_report(
         ),
         (None, None) => "Stable over the whole range.".to_string(),
     };
+    let op = &s["operating"];
+    if let Some(rpm) = num(&op["rpm"]) {
+        stability.push_str(&format!(
+            " At the operating speed {rpm:.1} rpm the least damped mode ({} whirl) has \
+             logarithmic decrement {}{}.",
+            op["whirl"].as_str().unwrap_or("no"),
+            num(&op["log_dec"]).map_or("-".into(), |d| match num(&op["log_dec_std"]) {
+                Some(sd) if sd > 0.0 => with_std(d, Some(sd), ""),
+                _ => fmt_sig(d, 4),
+            }),
+            if op["stable"].as_bool() == Some(false) {
+                ": UNSTABLE"
+            } else {
+                ""
+            }
+        ));
+    }
     let peaks = a["unbalance_response"]["channels"]
         .as_array()
         .map(|chs| {

@@ -398,3 +398,97 @@ fn analyze_and_balance_read_the_summary_identify_writes() {
     );
     assert!((mass - 1e-4).abs() < 5.0 * std, "{b}");
 }
+
+/// A cross-coupled summary as `rotorid identify --model cross_coupled` writes it (schema 3:
+/// `model`, `rotor` in the model's names, covariance names cxx, kxx, ...): the rotor of
+/// `rotorid::analysis`'s tests whose forward mode goes unstable at 3208.3 rpm (a < 0:
+/// the forward frequency falls with speed, and with it the damping force opposing the
+/// cross-coupling).
+const CROSS_SUMMARY: &str = r#"{"schema": 3, "method": "refine", "model": "cross_coupled",
+  "rotor": {"m": 14.29, "cxx": 200.0, "cxz": 10.0, "czx": -5.0, "czz": 180.0,
+            "kxx": 1.195e6, "kxz": -4.5e4, "kzx": 5.5e4, "kzz": 1.25e6,
+            "a": -2.871, "mud": 1.5e-5, "alpha": 0.7853981633974483},
+  "covariance": {"names": ["m", "cxx", "cxz", "czx", "czz", "kxx", "kxz", "kzx", "kzz", "x0"],
+    "matrix": [[1.8e-3, 0, 0, 0, 0, 1.2e2, 0, 0, 0, 0],
+               [0, 4.0, 0, 0, 0, 0, 0, 0, 0, 0],
+               [0, 0, 1.0, 0, 0, 0, 0, 0, 0, 0],
+               [0, 0, 0, 1.0, 0, 0, 0, 0, 0, 0],
+               [0, 0, 0, 0, 3.24, 0, 0, 0, 0, 0],
+               [1.2e2, 0, 0, 0, 0, 1.3e7, 0, 0, 0, 0],
+               [0, 0, 0, 0, 0, 0, 9.0e4, -4.5e4, 0, 0],
+               [0, 0, 0, 0, 0, 0, -4.5e4, 9.0e4, 0, 0],
+               [0, 0, 0, 0, 0, 0, 0, 0, 1.4e7, 0],
+               [0, 0, 0, 0, 0, 0, 0, 0, 0, 1e-12]]}}"#;
+
+#[test]
+fn analyze_reports_the_threshold_of_a_cross_coupled_rotor() {
+    let dir = tempfile::tempdir().unwrap();
+    let summary = dir.path().join("cross.json");
+    std::fs::write(&summary, CROSS_SUMMARY).unwrap();
+    let out = dir.path().join("a");
+    rotorid()
+        .arg("analyze")
+        .arg(&summary)
+        .args(["--rpm", "0:6000:20", "--operating-rpm", "3600", "--out"])
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout(contains("UNSTABLE above the threshold speed 32"))
+        .stderr(
+            contains("warning: UNSTABLE above the threshold speed")
+                .and(contains("the forward whirl"))
+                .and(contains("cross-coupled"))
+                .and(contains("UNSTABLE at the operating speed 3600.0 rpm"))
+                .and(contains("stable whenever").not()),
+        );
+    let j = read_json(&out.join("analysis.json"));
+    assert_eq!(j["model"], "cross_coupled");
+    assert_eq!(j["rotor"]["kzx"], 5.5e4);
+    assert!(
+        j["rotor_std"]["kzx"].as_f64().unwrap() == 300.0,
+        "{}",
+        j["rotor_std"]
+    );
+    let s = &j["stability"];
+    assert_eq!(s["stable"], false);
+    // the library's threshold (rotorid tests/it/analysis_cross.rs: 3208.334 rpm, checked
+    // there against the exact simulator), whatever the grid step
+    let t = s["threshold_rpm"].as_f64().unwrap();
+    assert!((t - 3208.334).abs() < 1e-3, "{s}");
+    let t_std = s["threshold_rpm_std"].as_f64().unwrap();
+    assert!(t_std > 1.0 && t_std < 1000.0, "{s}");
+    assert_eq!(s["threshold_whirl"], "forward");
+    assert_eq!(s["unstable_at_start"], false);
+    assert!(s["stable_from_rpm"].is_null());
+    let op = &s["operating"];
+    assert_eq!(
+        (op["rpm"].as_f64(), op["source"].as_str()),
+        (Some(3600.0), Some("given"))
+    );
+    assert_eq!(op["stable"], false);
+    assert_eq!(op["whirl"], "forward");
+    assert!(op["log_dec"].as_f64().unwrap() < 0.0);
+    assert!(op["log_dec_std"].as_f64().unwrap() > 0.0);
+    for c in j["critical_speeds"].as_array().unwrap() {
+        assert!(c["log_dec_std"].as_f64().unwrap() > 0.0, "{c}");
+        assert!(c["std_rpm"].as_f64().unwrap() > 0.1, "{c}");
+    }
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("Unstable above the threshold speed") && html.contains("kzx"));
+    assert!(!html.contains("stable at every speed"));
+
+    // below the threshold the margin at the operating speed is positive, with its std
+    rotorid()
+        .arg("analyze")
+        .arg(&summary)
+        .args(["--rpm", "0:3000:20", "--operating-rpm", "2800", "--out"])
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout(contains("stable over the range").and(contains("stability margin at 2800.0 rpm")));
+    let j = read_json(&out.join("analysis.json"));
+    let s = &j["stability"];
+    assert_eq!(s["stable"], true);
+    assert!(s["threshold_rpm"].is_null() && s["threshold_rpm_std"].is_null());
+    assert!(s["operating"]["log_dec"].as_f64().unwrap() > 0.0);
+}

@@ -1,8 +1,11 @@
 //! The parameters' covariance and first-order (delta-method) propagation through a result.
 //!
 //! The parameters are those of the refinement's internal parametrisation
-//! (`refine::Refined::covariance`): m, cx, kx, cz, kz, a and the unbalance as
-//! u_c = m_u d cos(alpha), u_s = m_u d sin(alpha), in which the unbalance force is linear.
+//! (`refine::Refined::covariance`): m, cx, kx, cz, kz, a, the cross-coupled bearing
+//! coefficients cxz, czx, kxz, kzx (docs/method.md section 1.6; the cross-coupled model
+//! calls cx, cz, kx, kz cxx, czz, kxx, kzz, and either name is accepted) and the unbalance
+//! as u_c = m_u d cos(alpha), u_s = m_u d sin(alpha), in which the unbalance force is
+//! linear.
 //! For a result y = f(theta) with gradient g = df/dtheta at the estimate,
 //!
 //! ```text
@@ -47,20 +50,29 @@ pub enum CovarianceParameter {
     MudCosAlpha,
     /// u_s = m_u d sin(alpha) \[kg m\].
     MudSinAlpha,
+    /// Cross-coupled damping cxz (force in x per unit velocity in z) \[N s/m\].
+    Cxz,
+    /// Cross-coupled damping czx (force in z per unit velocity in x) \[N s/m\].
+    Czx,
+    /// Cross-coupled stiffness kxz (force in x per unit displacement in z) \[N/m\].
+    Kxz,
+    /// Cross-coupled stiffness kzx (force in z per unit displacement in x) \[N/m\].
+    Kzx,
 }
 
 /// The names [`ParameterCovariance::new`] accepts, for messages.
-pub const PARAMETER_NAMES: &str = "m, cx, kx, cz, kz, a, mud_cos_alpha, mud_sin_alpha";
+pub const PARAMETER_NAMES: &str = "m, cx, kx, cz, kz, a, mud_cos_alpha, mud_sin_alpha, cxz, czx, kxz, kzx (cxx, czz, kxx, kzz for cx, cz, kx, kz)";
 
 /// Number of parameters: the length of every gradient.
-pub(crate) const NPARAM: usize = 8;
+pub(crate) const NPARAM: usize = 12;
 
 /// A gradient (or any vector) over the parameters, indexed by [`CovarianceParameter::index`].
 pub(crate) type Gradient = [f64; NPARAM];
 
 impl CovarianceParameter {
-    /// Every parameter, in index order.
-    pub const ALL: [CovarianceParameter; NPARAM] = [
+    /// The Jeffcott rotor's parameters, in index order (those of a Jeffcott fit's
+    /// covariance; the cross-coupled model adds [`CovarianceParameter::CROSS`]).
+    pub const ALL: [CovarianceParameter; 8] = [
         CovarianceParameter::M,
         CovarianceParameter::Cx,
         CovarianceParameter::Kx,
@@ -70,6 +82,19 @@ impl CovarianceParameter {
         CovarianceParameter::MudCosAlpha,
         CovarianceParameter::MudSinAlpha,
     ];
+
+    /// The cross-coupled bearing coefficients, in index order (after [`CovarianceParameter::ALL`]).
+    pub const CROSS: [CovarianceParameter; 4] = [
+        CovarianceParameter::Cxz,
+        CovarianceParameter::Czx,
+        CovarianceParameter::Kxz,
+        CovarianceParameter::Kzx,
+    ];
+
+    /// Every parameter of either model, in index order.
+    pub fn every() -> impl Iterator<Item = CovarianceParameter> {
+        Self::ALL.into_iter().chain(Self::CROSS)
+    }
 
     /// The name as the refinement writes it (`m`, ..., `mud_cos_alpha`, `mud_sin_alpha`).
     pub fn name(self) -> &'static str {
@@ -82,26 +107,44 @@ impl CovarianceParameter {
             CovarianceParameter::A => "a",
             CovarianceParameter::MudCosAlpha => "mud_cos_alpha",
             CovarianceParameter::MudSinAlpha => "mud_sin_alpha",
+            CovarianceParameter::Cxz => "cxz",
+            CovarianceParameter::Czx => "czx",
+            CovarianceParameter::Kxz => "kxz",
+            CovarianceParameter::Kzx => "kzx",
         }
     }
 
-    /// The parameter called `name`, if any.
+    /// The parameter called `name`, if any: its [`CovarianceParameter::name`] or the
+    /// cross-coupled model's name of a direct coefficient (cxx, czz, kxx, kzz for cx, cz,
+    /// kx, kz).
     pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|p| p.name() == name)
+        match name {
+            "cxx" => Some(CovarianceParameter::Cx),
+            "czz" => Some(CovarianceParameter::Cz),
+            "kxx" => Some(CovarianceParameter::Kx),
+            "kzz" => Some(CovarianceParameter::Kz),
+            _ => Self::every().find(|p| p.name() == name),
+        }
     }
 
     /// SI unit.
     pub fn unit(self) -> &'static str {
         match self {
             CovarianceParameter::M => "kg",
-            CovarianceParameter::Cx | CovarianceParameter::Cz => "N s/m",
-            CovarianceParameter::Kx | CovarianceParameter::Kz => "N/m",
+            CovarianceParameter::Cx
+            | CovarianceParameter::Cz
+            | CovarianceParameter::Cxz
+            | CovarianceParameter::Czx => "N s/m",
+            CovarianceParameter::Kx
+            | CovarianceParameter::Kz
+            | CovarianceParameter::Kxz
+            | CovarianceParameter::Kzx => "N/m",
             CovarianceParameter::A => "N s^2/m",
             CovarianceParameter::MudCosAlpha | CovarianceParameter::MudSinAlpha => "kg m",
         }
     }
 
-    /// Position in [`CovarianceParameter::ALL`].
+    /// Position in [`CovarianceParameter::every`].
     pub(crate) fn index(self) -> usize {
         self as usize
     }
@@ -113,11 +156,54 @@ impl fmt::Display for CovarianceParameter {
     }
 }
 
-/// The value of every parameter at a rotor: (m, cx, kx, cz, kz, a, u_c, u_s).
+/// The value of every parameter at a rotor: (m, cx, kx, cz, kz, a, u_c, u_s, cxz, czx,
+/// kxz, kzx), the cross terms 0 for a Jeffcott rotor.
 pub(crate) fn values(p: &crate::model::RotorParams) -> Gradient {
     let mud = p.unbalance.mud();
     let (s, c) = p.unbalance.alpha.sin_cos();
-    [p.m, p.cx, p.kx, p.cz, p.kz, p.a, mud * c, mud * s]
+    let x = p.cross();
+    [
+        p.m,
+        p.cx,
+        p.kx,
+        p.cz,
+        p.kz,
+        p.a,
+        mud * c,
+        mud * s,
+        x.cxz,
+        x.czx,
+        x.kxz,
+        x.kzx,
+    ]
+}
+
+/// The rotor with the parameter values `v` (as [`values`] orders them), the unbalance
+/// from u_c, u_s at d = 1 m; cross-coupled when `p` is.
+#[cfg(test)]
+pub(crate) fn with_values(
+    p: &crate::model::RotorParams,
+    v: &Gradient,
+) -> crate::model::RotorParams {
+    crate::model::RotorParams {
+        m: v[0],
+        cx: v[1],
+        kx: v[2],
+        cz: v[3],
+        kz: v[4],
+        a: v[5],
+        unbalance: crate::model::Unbalance {
+            m_u: v[6].hypot(v[7]),
+            d: 1.0,
+            alpha: v[7].atan2(v[6]),
+        },
+        coupling: p.coupling.map(|_| crate::model::CrossCoupling {
+            cxz: v[8],
+            czx: v[9],
+            kxz: v[10],
+            kzx: v[11],
+        }),
+    }
 }
 
 /// The covariance of a subset of the parameters (SI units of each, squared), e.g. that of
@@ -312,10 +398,21 @@ mod tests {
             assert_eq!(CovarianceParameter::from_name(p.name()), Some(p));
             assert_eq!(CovarianceParameter::ALL[p.index()], p);
         }
+        for (i, p) in CovarianceParameter::every().enumerate() {
+            assert_eq!(CovarianceParameter::from_name(p.name()), Some(p));
+            assert_eq!(p.index(), i);
+        }
+        assert_eq!(CovarianceParameter::every().count(), NPARAM);
+        assert_eq!(
+            CovarianceParameter::from_name("kxx"),
+            Some(CovarianceParameter::Kx)
+        );
+        let e = ParameterCovariance::new(names(&["kx", "kxx"]), vec![vec![1.0; 2]; 2]).unwrap_err();
+        assert!(matches!(e, AnalysisError::DuplicateParameter { .. }), "{e}");
         let e = ParameterCovariance::new(names(&["m", "k"]), vec![vec![1.0; 2]; 2]).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "unknown parameter \"k\" in the covariance: expected names from m, cx, kx, cz, kz, a, mud_cos_alpha, mud_sin_alpha"
+            "unknown parameter \"k\" in the covariance: expected names from m, cx, kx, cz, kz, a, mud_cos_alpha, mud_sin_alpha, cxz, czx, kxz, kzx (cxx, czz, kxx, kzz for cx, cz, kx, kz)"
         );
         let e = ParameterCovariance::new(names(&["m", "m"]), vec![vec![1.0; 2]; 2]).unwrap_err();
         assert!(matches!(e, AnalysisError::DuplicateParameter { .. }), "{e}");

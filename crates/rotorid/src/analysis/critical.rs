@@ -21,6 +21,7 @@
 //! d lambda / d theta = -r (dQ/dtheta) u / (r Q'(lambda) u),     Q'(lambda) = 2 lambda M + C1 + W C2
 //! dQ/dm = lambda^2 I     dQ/dcx = lambda E_11   dQ/dkx = E_11   (cz, kz: E_22)
 //! dQ/da = lambda W J     dQ/dW = lambda a J,    J = [[0, -1], [1, 0]]
+//! dQ/dcxz = lambda E_12  dQ/dkxz = E_12         (czx, kzx: E_21)
 //! ```
 //!
 //! The unbalance does not move the eigenvalues (its gradient entries are 0). At a double
@@ -34,6 +35,7 @@ use crate::model::{rad_per_s_to_rpm, RotorParams};
 use super::covariance::{std_of, CovarianceParameter, Gradient, ParameterCovariance, NPARAM};
 use super::error::{check_params, check_speeds, AnalysisError};
 use super::modes::{Mode, Quadratic, Whirl, C64};
+use super::stability::log_dec_gradient;
 
 /// Bisection stops when the bracket is narrower than this fraction of the speed.
 const BRACKET: f64 = 1e-13;
@@ -52,6 +54,11 @@ pub struct CriticalSpeed {
     pub mode: usize,
     /// The mode at W_c (its damped natural frequency equals W_c).
     pub at: Mode,
+    /// The standard deviation of its logarithmic decrement at W_c (dimensionless): the
+    /// total derivative d delta / d theta + (d delta / d W) (d W_c / d theta) propagated
+    /// under the covariance (the stability module's derivative of delta); `None` like
+    /// `std`, or when the mode does not oscillate.
+    pub log_dec_std: Option<f64>,
 }
 
 impl CriticalSpeed {
@@ -93,11 +100,14 @@ pub fn critical_speeds(
                 let wc = bisect(|w| g(i, w), prev, next);
                 let at = Quadratic::new(p, wc).modes()[i];
                 let std = gradient(p, wc, i).and_then(|grad| std_of(cov, &grad));
+                let log_dec_std =
+                    log_dec_gradient_at_critical(p, wc, i).and_then(|grad| std_of(cov, &grad));
                 out.push(CriticalSpeed {
                     speed: wc,
                     std,
                     mode: i,
                     at,
+                    log_dec_std,
                 });
             }
             prev = next;
@@ -151,6 +161,8 @@ pub(crate) fn eigenvalue_derivatives(
     let j = Matrix2::new(zero, -one, one, zero);
     let e11 = Matrix2::new(one, zero, zero, zero);
     let e22 = Matrix2::new(zero, zero, zero, one);
+    let e12 = Matrix2::new(zero, one, zero, zero);
+    let e21 = Matrix2::new(zero, zero, one, zero);
     let d = |dq: Matrix2<C64>| -(r * dq * u)[(0, 0)] / denom;
     let mut out = [zero; NPARAM];
     out[CovarianceParameter::M.index()] = d(Matrix2::identity() * (l * l));
@@ -159,6 +171,10 @@ pub(crate) fn eigenvalue_derivatives(
     out[CovarianceParameter::Cz.index()] = d(e22 * l);
     out[CovarianceParameter::Kz.index()] = d(e22);
     out[CovarianceParameter::A.index()] = d(j * (l * w));
+    out[CovarianceParameter::Cxz.index()] = d(e12 * l);
+    out[CovarianceParameter::Czx.index()] = d(e21 * l);
+    out[CovarianceParameter::Kxz.index()] = d(e12);
+    out[CovarianceParameter::Kzx.index()] = d(e21);
     Some((out, d(j * (l * p.a))))
 }
 
@@ -172,6 +188,14 @@ pub(crate) fn gradient(p: &RotorParams, wc: f64, i: usize) -> Option<Gradient> {
     }
     let grad = dl.map(|d| -d.im / slope);
     grad.iter().all(|g| g.is_finite()).then_some(grad)
+}
+
+/// The gradient of the logarithmic decrement of mode `i` at its critical speed `wc` over
+/// the parameters: d delta / d theta + (d delta / d W) (d W_c / d theta).
+pub(crate) fn log_dec_gradient_at_critical(p: &RotorParams, wc: f64, i: usize) -> Option<Gradient> {
+    let gw = gradient(p, wc, i)?;
+    let (gd, dw) = log_dec_gradient(p, wc, i)?;
+    Some(std::array::from_fn(|k| gd[k] + dw * gw[k]))
 }
 
 #[cfg(test)]
@@ -255,6 +279,52 @@ mod tests {
                     "mode {} parameter {k}: {fd} vs {}",
                     c.mode,
                     grad[k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn cross_coupled_critical_log_dec_gradient_matches_central_differences() {
+        let mut p = crate::test_models::cross_coupled_rotor();
+        p.coupling = Some(crate::model::CrossCoupling {
+            cxz: 20.0,
+            czx: -12.0,
+            kxz: -3.0e4,
+            kzx: 4.0e4,
+        });
+        p.cz = 120.0;
+        let grid: Vec<f64> = (0..=60).map(|k| 10.0 * k as f64).collect();
+        let cs = critical_speeds(&p, None, &grid).unwrap();
+        assert_eq!(cs.len(), 2);
+        let v = values(&p);
+        for c in &cs {
+            let grad = log_dec_gradient_at_critical(&p, c.speed, c.mode).unwrap();
+            let wgrad = gradient(&p, c.speed, c.mode).unwrap();
+            for k in (0..NPARAM).filter(|&k| k != 6 && k != 7) {
+                let h = 1e-5 * v[k].abs();
+                let at = |x: f64| {
+                    let mut vv = v;
+                    vv[k] = x;
+                    let q = crate::analysis::covariance::with_values(&p, &vv);
+                    let cs = critical_speeds(&q, None, &grid).unwrap();
+                    let d = cs.iter().find(|d| d.mode == c.mode).unwrap();
+                    (d.at.log_dec.unwrap(), d.speed)
+                };
+                let (up, dn) = (at(v[k] + h), at(v[k] - h));
+                let fd = (up.0 - dn.0) / (2.0 * h);
+                assert!(
+                    (fd - grad[k]).abs() <= 1e-5 * grad[k].abs() + 1e-12 / h,
+                    "mode {} parameter {k}: {fd} vs {}",
+                    c.mode,
+                    grad[k]
+                );
+                let fd = (up.1 - dn.1) / (2.0 * h);
+                assert!(
+                    (fd - wgrad[k]).abs() <= 1e-5 * wgrad[k].abs() + 4.0 * BRACKET * c.speed / h,
+                    "critical speed, mode {} parameter {k}: {fd} vs {}",
+                    c.mode,
+                    wgrad[k]
                 );
             }
         }

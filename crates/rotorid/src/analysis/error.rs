@@ -96,7 +96,8 @@ pub enum AnalysisError {
     },
 }
 
-/// Check the parameters the analysis uses: m > 0, kx, kz > 0, everything else finite.
+/// Check the parameters the analysis uses: m > 0, kx, kz > 0, everything else (the
+/// cross-coupled coefficients included) finite.
 /// Damping may be negative: an identified damping that came out below zero is analysed
 /// (and reported unstable) rather than rejected.
 pub(crate) fn check_params(p: &RotorParams) -> Result<(), AnalysisError> {
@@ -109,6 +110,12 @@ pub(crate) fn check_params(p: &RotorParams) -> Result<(), AnalysisError> {
     check("m_u", p.unbalance.m_u, "finite (kg)", |_| true)?;
     check("d", p.unbalance.d, "finite (m)", |_| true)?;
     check("alpha", p.unbalance.alpha, "finite (rad)", |_| true)?;
+    if let Some(c) = p.coupling {
+        check("cxz", c.cxz, "finite (N s/m)", |_| true)?;
+        check("czx", c.czx, "finite (N s/m)", |_| true)?;
+        check("kxz", c.kxz, "finite (N/m)", |_| true)?;
+        check("kzx", c.kzx, "finite (N/m)", |_| true)?;
+    }
     Ok(())
 }
 

@@ -7,9 +7,12 @@
 //!
 //! ```text
 //! M q'' + (C1 + W C2) q' + K1 q = F(t),    q = (x, z)
-//! M = m I,  C1 = diag(cx, cz),  C2 = [[0, -a], [a, 0]],  K1 = diag(kx, kz)
+//! M = m I,  C1 = [[cx, cxz], [czx, cz]],  C2 = [[0, -a], [a, 0]],  K1 = [[kx, kxz], [kzx, kz]]
 //! F = m_u d W^2 ( sin(phi + alpha), cos(phi + alpha) )
 //! ```
+//!
+//! with the cross-coupled terms cxz, czx, kxz, kzx of [`crate::model::CrossCoupling`] (0
+//! for the Jeffcott rotor, [`RotorParams::coupling`](crate::model::RotorParams) `None`).
 //!
 //! Conventions (those of ROSS and API 684): the shaft turns from +z (vertical up) toward
 //! +x (horizontal), the sense in which the unbalance force turns; forward whirl is whirl
@@ -23,7 +26,8 @@
 //! - `modes`: eigenvalues, damped natural frequencies, damping ratio, logarithmic
 //!   decrement, whirl direction; [`campbell`] over a speed grid.
 //! - `critical`: [`critical_speeds`] (1X crossings) with linearised standard deviations.
-//! - `stability`: minimum logarithmic decrement and threshold speed.
+//! - `stability`: minimum logarithmic decrement, threshold speed with its standard
+//!   deviation, and the stability margin (least damped mode) at an operating speed.
 //! - `response`: [`unbalance_response`] (amplitude, phase lag per probe) with standard
 //!   deviations.
 //! - [`balance`]: correction from the identified unbalance; influence-coefficient
@@ -67,4 +71,7 @@ pub use error::AnalysisError;
 pub use modes::{campbell, modes, Campbell, Mode, Whirl, PLANAR_WHIRL};
 pub use one_x::{one_x, synchronous_average, OneX};
 pub use response::{unbalance_response, Probe, ResponseChannel, ResponseVector, UnbalanceResponse};
-pub use stability::{stability, Stability, UNSTABLE_ZETA};
+pub use stability::{
+    stability, stability_margin, stability_with_covariance, Stability, StabilityMargin,
+    UNSTABLE_ZETA,
+};

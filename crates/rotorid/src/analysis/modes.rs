@@ -3,11 +3,15 @@
 //! ```text
 //! M q'' + (C1 + W C2) q' + K1 q = 0,     q = u e^{lambda t}:   Q(lambda) u = 0
 //! Q(lambda) = lambda^2 M + lambda (C1 + W C2) + K1
-//! det Q(lambda) = (m lambda^2 + cx lambda + kx)(m lambda^2 + cz lambda + kz) + a^2 W^2 lambda^2
+//! det Q(lambda) = (m lambda^2 + cx lambda + kx)(m lambda^2 + cz lambda + kz)
+//!                - ((cxz - a W) lambda + kxz)((czx + a W) lambda + kzx)
 //! ```
 //!
-//! with C1 = diag(cx, cz), C2 = \[\[0, -a\], \[a, 0\]\], K1 = diag(kx, kz). The four roots
-//! are the eigenvalues of the state matrix (nalgebra's real Schur form)
+//! with C1 = \[\[cx, cxz\], \[czx, cz\]\], C2 = \[\[0, -a\], \[a, 0\]\],
+//! K1 = \[\[kx, kxz\], \[kzx, kz\]\] (the cross-coupled bearings of docs/method.md section
+//! 1.6; the cross terms are 0 for the Jeffcott rotor, whose determinant is then
+//! (m l^2 + cx l + kx)(m l^2 + cz l + kz) + a^2 W^2 l^2). The four roots are the eigenvalues
+//! of the state matrix (nalgebra's real Schur form)
 //!
 //! ```text
 //! A = [[0, s I], [-K1 / (m s), -(C1 + W C2) / m]],   state (q, q' / s),   s = sqrt(max(kx, kz) / m)
@@ -40,7 +44,10 @@
 //! m w^2 - a W w - k = 0   (forward),      m w^2 + a W w - k = 0   (backward)
 //! ```
 //!
-//! so for a > 0 the forward frequency rises with speed and the backward one falls.
+//! so for a > 0 the forward frequency rises with speed and the backward one falls. On
+//! cross-coupled bearings with kzx = -kxz = Q (isotropic otherwise, c the damping) the
+//! forward mode solves m l^2 + c l + k = i (a W l + Q): kzx > 0 > kxz takes damping from
+//! forward whirl (stability module).
 //! References: M. Lalanne & G. Ferraris, *Rotordynamics prediction in engineering*, 2nd
 //! ed., Wiley, 1998, ch. 2 (Campbell diagram of the simple rotor); G. Genta, *Dynamics of
 //! rotating systems*, Springer, 2005, ch. 4 (whirl direction from the mode shape).
@@ -122,12 +129,18 @@ pub(crate) struct Quadratic {
     pub kx: f64,
     pub kz: f64,
     pub a: f64,
+    /// Cross-coupled bearing coefficients (0 for a Jeffcott rotor).
+    pub cxz: f64,
+    pub czx: f64,
+    pub kxz: f64,
+    pub kzx: f64,
     /// Speed W \[rad/s\].
     pub w: f64,
 }
 
 impl Quadratic {
     pub(crate) fn new(p: &RotorParams, w: f64) -> Self {
+        let x = p.cross();
         Self {
             m: p.m,
             cx: p.cx,
@@ -135,6 +148,10 @@ impl Quadratic {
             kx: p.kx,
             kz: p.kz,
             a: p.a,
+            cxz: x.cxz,
+            czx: x.czx,
+            kxz: x.kxz,
+            kzx: x.kzx,
             w,
         }
     }
@@ -142,22 +159,22 @@ impl Quadratic {
     /// Q(lambda).
     pub(crate) fn at(&self, l: C64) -> Matrix2<C64> {
         let l2 = l * l;
-        let g = l * (self.a * self.w);
+        let aw = self.a * self.w;
         Matrix2::new(
             l2 * self.m + l * self.cx + self.kx,
-            -g,
-            g,
+            l * (self.cxz - aw) + self.kxz,
+            l * (self.czx + aw) + self.kzx,
             l2 * self.m + l * self.cz + self.kz,
         )
     }
 
     /// dQ / dlambda = 2 lambda M + C1 + W C2.
     pub(crate) fn derivative(&self, l: C64) -> Matrix2<C64> {
-        let aw = C64::new(self.a * self.w, 0.0);
+        let aw = self.a * self.w;
         Matrix2::new(
             l * (2.0 * self.m) + self.cx,
-            -aw,
-            aw,
+            C64::new(self.cxz - aw, 0.0),
+            C64::new(self.czx + aw, 0.0),
             l * (2.0 * self.m) + self.cz,
         )
     }
@@ -166,8 +183,14 @@ impl Quadratic {
     pub(crate) fn scale(&self, l: C64) -> f64 {
         let n = l.norm();
         self.m * n * n
-            + self.cx.abs().max(self.cz.abs()) * n
-            + self.kx.max(self.kz)
+            + self
+                .cx
+                .abs()
+                .max(self.cz.abs())
+                .max(self.cxz.abs())
+                .max(self.czx.abs())
+                * n
+            + self.kx.max(self.kz).max(self.kxz.abs()).max(self.kzx.abs())
             + (self.a * self.w).abs() * n
     }
 
@@ -191,8 +214,8 @@ impl Quadratic {
         let a = Matrix4::new(
             0.0, 0.0, s, 0.0,
             0.0, 0.0, 0.0, s,
-            -self.kx / (m * s), 0.0, -self.cx / m, aw / m,
-            0.0, -self.kz / (m * s), -aw / m, -self.cz / m,
+            -self.kx / (m * s), -self.kxz / (m * s), -self.cx / m, -(self.cxz - aw) / m,
+            -self.kzx / (m * s), -self.kz / (m * s), -(self.czx + aw) / m, -self.cz / m,
         );
         let ev = a.complex_eigenvalues();
         [ev[0], ev[1], ev[2], ev[3]].map(|l| self.polish(l))
@@ -360,6 +383,131 @@ mod tests {
             );
             assert!((r * q.at(l)).norm() < 1e-9 * s * r.norm());
         }
+    }
+
+    /// The roots of det Q by Durand-Kerner iteration on the quartic's coefficients,
+    /// expanded by hand (an algorithm independent of the state matrix and nalgebra).
+    fn quartic_roots(q: &Quadratic) -> [C64; 4] {
+        let aw = q.a * q.w;
+        let (p1, p0) = (q.cxz - aw, q.kxz);
+        let (r1, r0) = (q.czx + aw, q.kzx);
+        let m = q.m;
+        // det Q = (m l^2 + cx l + kx)(m l^2 + cz l + kz) - (p1 l + p0)(r1 l + r0)
+        let c = [
+            q.kx * q.kz - p0 * r0,
+            q.cx * q.kz + q.cz * q.kx - p1 * r0 - p0 * r1,
+            m * (q.kx + q.kz) + q.cx * q.cz - p1 * r1,
+            m * (q.cx + q.cz),
+        ]
+        .map(|v| v / (m * m));
+        let poly = |l: C64| (((l + c[3]) * l + c[2]) * l + c[1]) * l + c[0];
+        let scale = (q.kx.max(q.kz) / m).sqrt();
+        let mut z: [C64; 4] = std::array::from_fn(|k| C64::new(0.4, 0.9).powu(k as u32) * scale);
+        for _ in 0..500 {
+            for k in 0..4 {
+                let mut d = C64::new(1.0, 0.0);
+                for j in (0..4).filter(|&j| j != k) {
+                    d *= z[k] - z[j];
+                }
+                z[k] -= poly(z[k]) / d;
+            }
+        }
+        z
+    }
+
+    fn cross_rotor() -> RotorParams {
+        let mut p = Rotor::table1().params();
+        p.kz = 1.4e6;
+        p.cx = 200.0;
+        p.cz = 150.0;
+        p.coupling = Some(crate::model::CrossCoupling {
+            cxz: 20.0,
+            czx: -15.0,
+            kxz: -4.0e4,
+            kzx: 6.0e4,
+        });
+        p
+    }
+
+    #[test]
+    fn eigenvalues_agree_with_the_characteristic_quartic() {
+        for w in [0.0, 150.0, 400.0, 900.0] {
+            // (Durand-Kerner converges slowly to the double root of the isotropic rotor at
+            // rest: the Jeffcott rotor here is anisotropic)
+            let mut jeffcott = Rotor::table1().params();
+            jeffcott.kz *= 1.3;
+            jeffcott.cz = 40.0;
+            for p in [cross_rotor(), jeffcott] {
+                let q = Quadratic::new(&p, w);
+                let scale = (p.kx.max(p.kz) / p.m).sqrt();
+                let mut want = quartic_roots(&q).to_vec();
+                let mut got = q.roots().to_vec();
+                for v in [&mut want, &mut got] {
+                    v.sort_by(|a, b| a.im.total_cmp(&b.im).then(a.re.total_cmp(&b.re)));
+                }
+                for (g, e) in got.iter().zip(&want) {
+                    assert!(
+                        (g - e).norm() < 1e-9 * scale,
+                        "W = {w}: {g} vs {e} (cross {:?})",
+                        p.coupling
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn isotropic_cross_coupled_rotor_matches_the_closed_form() {
+        // kzx = -kxz = Q, a = 0: m l^2 + c l + k = +-i Q; the + root whirls forward
+        let (m, c, k, qq) = (14.29, 200.0, 1.195e6, 5.0e4);
+        let p = RotorParams {
+            m,
+            cx: c,
+            cz: c,
+            kx: k,
+            kz: k,
+            a: 0.0,
+            unbalance: crate::model::Unbalance {
+                m_u: 0.0,
+                d: 0.0,
+                alpha: 0.0,
+            },
+            coupling: Some(crate::model::CrossCoupling {
+                cxz: 0.0,
+                czx: 0.0,
+                kxz: -qq,
+                kzx: qq,
+            }),
+        };
+        let root = |s: f64| {
+            let disc = (C64::new(c * c - 4.0 * m * k, 4.0 * m * s * qq)).sqrt();
+            let l = (-c + disc) / (2.0 * m);
+            let l2 = (-c - disc) / (2.0 * m);
+            // of the two roots, the one near +i sqrt(k/m)
+            if l.im > 0.0 {
+                l
+            } else {
+                l2
+            }
+        };
+        let (fwd, bwd) = (root(1.0), root(-1.0));
+        // a = 0: both modes have the same frequency; they differ in damping and whirl
+        let ms = modes(&p, 100.0).unwrap();
+        let forward = ms.iter().find(|m| m.whirl == Some(Whirl::Forward)).unwrap();
+        let backward = ms
+            .iter()
+            .find(|m| m.whirl == Some(Whirl::Backward))
+            .unwrap();
+        for (mode, want) in [(backward, bwd), (forward, fwd)] {
+            assert!(
+                (mode.eigenvalue - want).norm() < 1e-10 * want.norm(),
+                "{} vs {want}",
+                mode.eigenvalue
+            );
+            assert!((mode.whirl_ratio.unwrap().abs() - 1.0).abs() < 1e-9);
+        }
+        // the cross-coupled stiffness kzx > 0 > kxz takes damping from the forward mode
+        assert!(forward.damping_ratio < backward.damping_ratio);
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! ```text
 //! q(t) = Re( P e^{i phi} ),   P = U h(W),   h(W) = D^-1 W^2 (-i, 1)^T
 //! D = K1 - W^2 M + i W (C1 + W C2)                       (complex 2x2)
+//! C1 = [[cx, cxz], [czx, cz]],  K1 = [[kx, kxz], [kzx, kz]]  (cross terms 0: Jeffcott)
 //! ```
 //!
 //! (D P = W^2 (-i, 1) U is eq. (1) with q = Re(P e^{i phi}), phi = W t + phi0.) A probe at
@@ -20,8 +21,9 @@
 //! Uncertainty (delta method, covariance module), from the derivatives
 //!
 //! ```text
-//! dP/dtheta = -D^-1 (dD/dtheta) P            (theta = m, cx, kx, cz, kz, a)
+//! dP/dtheta = -D^-1 (dD/dtheta) P            (theta = m, cx, kx, cz, kz, a, cxz, czx, kxz, kzx)
 //! dD/dm = -W^2 I   dD/dcx = i W E_11   dD/dkx = E_11   (cz, kz: E_22)   dD/da = i W^2 J
+//! dD/dcxz = i W E_12   dD/dkxz = E_12   (czx, kzx: E_21)
 //! dP/du_c = h,     dP/du_s = i h
 //! d|V| = Re(conj(V) dV) / |V|,     d beta = -Im(conj(V) dV) / |V|^2
 //! ```
@@ -151,10 +153,11 @@ pub struct UnbalanceResponse {
 pub(crate) fn transfer(p: &RotorParams, w: f64) -> Option<(Vector2<C64>, Matrix2<C64>)> {
     let i = Complex::new(0.0, 1.0);
     let c = |re: f64, im: f64| Complex::new(re, im);
+    let x = p.cross();
     let d = Matrix2::new(
         c(p.kx - p.m * w * w, w * p.cx),
-        c(0.0, -p.a * w * w),
-        c(0.0, p.a * w * w),
+        c(x.kxz, w * x.cxz - p.a * w * w),
+        c(x.kzx, w * x.czx + p.a * w * w),
         c(p.kz - p.m * w * w, w * p.cz),
     );
     let det = d[(0, 0)] * d[(1, 1)] - d[(0, 1)] * d[(1, 0)];
@@ -194,6 +197,12 @@ pub(crate) fn response_and_gradient(
     g[CovarianceParameter::Cz.index()] = dp(e22 * (i * w));
     g[CovarianceParameter::Kz.index()] = dp(e22);
     g[CovarianceParameter::A.index()] = dp(j * (i * w * w));
+    let e12 = Matrix2::new(zero, Complex::new(1.0, 0.0), zero, zero);
+    let e21 = Matrix2::new(zero, zero, Complex::new(1.0, 0.0), zero);
+    g[CovarianceParameter::Cxz.index()] = dp(e12 * (i * w));
+    g[CovarianceParameter::Czx.index()] = dp(e21 * (i * w));
+    g[CovarianceParameter::Kxz.index()] = dp(e12);
+    g[CovarianceParameter::Kzx.index()] = dp(e21);
     g[CovarianceParameter::MudCosAlpha.index()] = h;
     g[CovarianceParameter::MudSinAlpha.index()] = h * i;
     Some((pv, g))
@@ -274,7 +283,8 @@ mod tests {
         let w = 280.0;
         let (_, g) = response_and_gradient(&p, w).unwrap();
         let v = values(&p);
-        for k in 0..NPARAM {
+        // the Jeffcott parameters (the cross terms: the next test)
+        for k in 0..8 {
             let h = 1e-6 * v[k].abs();
             let (mut up, mut dn) = (v, v);
             up[k] += h;
@@ -287,6 +297,35 @@ mod tests {
                 "parameter {k}: {fd} vs {}",
                 g[k]
             );
+        }
+    }
+
+    #[test]
+    fn cross_coupled_derivatives_match_central_differences() {
+        let mut p = crate::test_models::cross_coupled_rotor();
+        p.coupling = Some(crate::model::CrossCoupling {
+            cxz: 20.0,
+            czx: -12.0,
+            kxz: -3.0e4,
+            kzx: 4.0e4,
+        });
+        for w in [150.0, 280.0, 320.0] {
+            let (_, g) = response_and_gradient(&p, w).unwrap();
+            let v = values(&p);
+            for k in 0..NPARAM {
+                let h = 1e-6 * v[k].abs();
+                let (mut up, mut dn) = (v, v);
+                up[k] += h;
+                dn[k] -= h;
+                let at =
+                    |v| response_and_gradient(&super::super::covariance::with_values(&p, v), w);
+                let fd = (at(&up).unwrap().0 - at(&dn).unwrap().0) / Complex::new(2.0 * h, 0.0);
+                assert!(
+                    (fd - g[k]).norm() < 1e-6 * g[k].norm(),
+                    "W {w} parameter {k}: {fd} vs {}",
+                    g[k]
+                );
+            }
         }
     }
 

@@ -9,6 +9,7 @@ mod acquisition_iterated;
 mod adequacy;
 mod algebraic_windows;
 mod analysis;
+mod analysis_cross;
 mod balance;
 mod cross_algebraic;
 mod cross_modulating;

@@ -43,7 +43,7 @@ use super::multi::{balance, BalanceOptions};
 
 use crate::model::{check, RotorParams};
 
-use crate::analysis::covariance::{values, CovarianceParameter, Gradient, ParameterCovariance};
+use crate::analysis::covariance::{values, CovarianceParameter, Gradient, ParameterCovariance, NPARAM};
 use crate::analysis::error::{check_params, check_speed, AnalysisError};
 use crate::analysis::modes::C64;
 use crate::analysis::one_x::OneX;
@@ -133,7 +133,7 @@ pub fn balance_from_unbalance(
         v[CovarianceParameter::MudSinAlpha.index()],
     );
     let unit = |q: CovarianceParameter| {
-        let mut g: Gradient = [0.0; 8];
+        let mut g: Gradient = [0.0; NPARAM];
         g[q.index()] = 1.0;
         g
     };
