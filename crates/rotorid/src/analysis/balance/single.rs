@@ -43,7 +43,9 @@ use super::multi::{balance, BalanceOptions};
 
 use crate::model::{check, RotorParams};
 
-use crate::analysis::covariance::{values, CovarianceParameter, Gradient, ParameterCovariance, NPARAM};
+use crate::analysis::covariance::{
+    values, CovarianceParameter, Gradient, ParameterCovariance, NPARAM,
+};
 use crate::analysis::error::{check_params, check_speed, AnalysisError};
 use crate::analysis::modes::C64;
 use crate::analysis::one_x::OneX;
