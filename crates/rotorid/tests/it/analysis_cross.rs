@@ -233,3 +233,37 @@ fn analysis_threshold_and_log_dec_std_agree_with_monte_carlo() {
         margin.log_dec_std.unwrap()
     );
 }
+
+/// The check on identified data: refine's fit of the cross-coupled rotor (40 dB,
+/// constant speed from rest, several seeds) and its covariance give the least damped
+/// mode's logarithmic decrement at the operating speed within 3 of its standard deviations
+/// of the true rotor's.
+#[test]
+fn the_log_decrement_of_an_identified_cross_coupled_rotor_is_within_three_std_of_the_truth() {
+    use rotorid::pipeline::{identify, Method as IdMethod, ModelChoice, RefineSettings};
+    use rotorid::test_models::{cross_coupled, cross_coupled_rotor};
+    let truth = cross_coupled_rotor();
+    let w = rpm_to_rad_per_s(1200.0);
+    let want = stability_margin(&truth, None, w)
+        .unwrap()
+        .log_dec()
+        .unwrap();
+    let method = IdMethod::Refine(RefineSettings {
+        model: Some(ModelChoice::CrossCoupled),
+        ..RefineSettings::default()
+    });
+    let mut zs = Vec::new();
+    for seed in 0..6 {
+        let tm = cross_coupled().with_noise(40.0, 300 + seed);
+        let id = identify(&tm.record(), &tm.knowledge(), &method).unwrap();
+        let p = id.rotor.as_ref().unwrap().params();
+        let cov =
+            ParameterCovariance::from_identification(id.covariance.as_ref().unwrap()).unwrap();
+        let m = stability_margin(&p, Some(&cov), w).unwrap();
+        let (ld, sd) = (m.log_dec().unwrap(), m.log_dec_std.unwrap());
+        assert!(sd > 0.0 && sd < 0.2 * want, "seed {seed}: {ld} +- {sd}");
+        zs.push((ld - want) / sd);
+    }
+    println!("log decrement at 1200 rpm {want:.5}: (identified - true) / std = {zs:.2?}");
+    assert!(zs.iter().all(|z| z.abs() < 3.0), "{zs:?}");
+}
