@@ -289,6 +289,7 @@ impl ParameterCovariance {
                 });
             }
         }
+        check_semidefinite(&names, &matrix, &undetermined)?;
         Ok(Self {
             names,
             matrix,
@@ -384,12 +385,132 @@ pub(crate) fn std_of(cov: Option<&ParameterCovariance>, g: &Gradient) -> Option<
     cov.and_then(|c| c.propagate(g))
 }
 
+/// Relative tolerance of the symmetry and semi-definiteness checks (rounding of a
+/// covariance computed and written in double precision is far below it).
+const SEMIDEFINITE_TOLERANCE: f64 = 1e-8;
+
+/// A covariance must be symmetric and positive semi-definite over its determined
+/// parameters: each correlation within [-1, 1], and no negative eigenvalue of the
+/// correlation matrix (beyond [`SEMIDEFINITE_TOLERANCE`]). A matrix that is not would give
+/// imaginary standard deviations, which used to be clamped to 0 without a word.
+fn check_semidefinite(
+    names: &[String],
+    matrix: &[Vec<f64>],
+    undetermined: &[bool],
+) -> Result<(), AnalysisError> {
+    let idx: Vec<usize> = (0..names.len())
+        .filter(|&i| !undetermined[i] && matrix[i][i] > 0.0)
+        .collect();
+    let sd = |i: usize| matrix[i][i].sqrt();
+    for (a, &i) in idx.iter().enumerate() {
+        for &j in &idx[a + 1..] {
+            let (cij, cji) = (matrix[i][j], matrix[j][i]);
+            let scale = sd(i) * sd(j);
+            if (cij - cji).abs() > SEMIDEFINITE_TOLERANCE * scale {
+                return Err(AnalysisError::NotSymmetric {
+                    first: names[i].clone(),
+                    second: names[j].clone(),
+                    upper: cij,
+                    lower: cji,
+                });
+            }
+            let r = cij / scale;
+            if r.abs() > 1.0 + SEMIDEFINITE_TOLERANCE {
+                return Err(AnalysisError::NotSemidefinite {
+                    detail: format!(
+                        "the correlation of {} and {} is {r:.6} (must be within -1 and 1)",
+                        names[i], names[j]
+                    ),
+                });
+            }
+        }
+    }
+    let n = idx.len();
+    if n < 3 {
+        return Ok(());
+    }
+    let corr = nalgebra::DMatrix::from_fn(n, n, |a, b| {
+        let (i, j) = (idx[a], idx[b]);
+        0.5 * (matrix[i][j] + matrix[j][i]) / (sd(i) * sd(j))
+    });
+    let eig = corr.symmetric_eigen();
+    let (k, min) =
+        eig.eigenvalues
+            .iter()
+            .copied()
+            .enumerate()
+            .fold(
+                (0, f64::INFINITY),
+                |b, (k, v)| if v < b.1 { (k, v) } else { b },
+            );
+    if min < -SEMIDEFINITE_TOLERANCE * n as f64 {
+        // the parameters of the offending direction, largest first
+        let v = eig.eigenvectors.column(k);
+        let mut parts: Vec<(f64, &str)> = (0..n)
+            .map(|a| (v[a].abs(), names[idx[a]].as_str()))
+            .filter(|(w, _)| *w > 0.1)
+            .collect();
+        parts.sort_by(|x, y| y.0.total_cmp(&x.0));
+        let who: Vec<&str> = parts.iter().map(|p| p.1).collect();
+        return Err(AnalysisError::NotSemidefinite {
+            detail: format!(
+                "its correlation matrix has the eigenvalue {min:.3e} < 0, in the direction of {}",
+                who.join(", ")
+            ),
+        });
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn names(v: &[&str]) -> Vec<String> {
         v.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn a_covariance_that_is_not_symmetric_or_semidefinite_is_refused_by_name() {
+        // a correlation of 17 between m and kxx (what an edited summary can hold)
+        let e = ParameterCovariance::new(
+            names(&["m", "kxx"]),
+            vec![
+                vec![1e-4, 17.0 * 1e-2 * 100.0],
+                vec![17.0 * 1e-2 * 100.0, 1e4],
+            ],
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "the covariance is not positive semi-definite: the correlation of m and kxx is 17.000000 (must be within -1 and 1)"
+        );
+        let e = ParameterCovariance::new(names(&["m", "kx"]), vec![vec![1.0, 0.5], vec![0.4, 1.0]])
+            .unwrap_err();
+        assert!(matches!(e, AnalysisError::NotSymmetric { .. }), "{e}");
+        // every correlation within [-1, 1] but the three together impossible: 0.9, 0.9 and
+        // -0.9 (eigenvalue 1 - 1.8 < 0)
+        let c = vec![
+            vec![1.0, 0.9, 0.9],
+            vec![0.9, 1.0, -0.9],
+            vec![0.9, -0.9, 1.0],
+        ];
+        let e = ParameterCovariance::new(names(&["m", "kx", "kz"]), c).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("eigenvalue -8.000e-1 < 0, in the direction of"),
+            "{e}"
+        );
+        // a valid one, and one with an undetermined (non-finite) parameter, pass
+        let ok = vec![
+            vec![1.0, 0.9, 0.0],
+            vec![0.9, 1.0, 0.0],
+            vec![0.0, 0.0, f64::INFINITY],
+        ];
+        ParameterCovariance::new(names(&["m", "kx", "kz"]), ok).unwrap();
+        // rounding of a symmetric matrix written in double precision passes
+        let r = vec![vec![1.0, 1.0 + 1e-12], vec![1.0, 1.0 + 2e-12]];
+        ParameterCovariance::new(names(&["m", "kx"]), r).unwrap();
     }
 
     #[test]

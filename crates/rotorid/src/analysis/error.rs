@@ -48,6 +48,25 @@ pub enum AnalysisError {
         /// Its diagonal entry.
         value: f64,
     },
+    /// A covariance whose entries (i, j) and (j, i) differ.
+    #[error("the covariance is not symmetric: its entry ({first}, {second}) is {upper} but ({second}, {first}) is {lower}")]
+    NotSymmetric {
+        /// The row parameter.
+        first: String,
+        /// The column parameter.
+        second: String,
+        /// Entry (first, second).
+        upper: f64,
+        /// Entry (second, first).
+        lower: f64,
+    },
+    /// A covariance that is not positive semi-definite (it would give imaginary standard
+    /// deviations).
+    #[error("the covariance is not positive semi-definite: {detail}")]
+    NotSemidefinite {
+        /// Which correlation or direction, with its value.
+        detail: String,
+    },
     /// Two per-sample arrays that must have the same length do not.
     #[error(
         "{field} has {len} samples but {other} has {expected}: they must have the same length"
