@@ -99,7 +99,10 @@ pub(crate) fn find(
 ) -> Result<Found, PipelineError> {
     let mut found = find_jeffcott(rec, k, s, u)?;
     if model == ModelKind::CrossCoupled {
-        match cross_modulating_start(rec, k, s, u, &with_cross(&found.params, k, u)) {
+        // the Jeffcott start in the cross-coupled model: the base of the modulating start
+        // (known values) and the fallback
+        let nested = with_cross(&found.params, k, u);
+        match cross_modulating_start(rec, k, s, u, &nested) {
             Ok((t, params)) => {
                 found.params = params;
                 found.start = start(
@@ -110,7 +113,7 @@ pub(crate) fn find(
                 );
             }
             Err(why) => {
-                found.params = with_cross(&found.params, k, u);
+                found.params = nested;
                 found.start.values = RotorSummary::of(&found.params);
                 let note = format!(
                     "cross-coupled modulating estimate unusable ({why}): the Jeffcott start \
