@@ -19,6 +19,7 @@
 //! *Rotordynamics prediction in engineering*, 2nd ed., Wiley, 1998.
 
 mod error;
+pub mod finite_element;
 mod rotor;
 mod scenario;
 mod speed;
