@@ -52,12 +52,10 @@ fn bench(c: &mut Criterion) {
                 .expect("valid session");
             let mut acc = 0.0;
             for x in &samples {
-                s.push(black_box(x), &mut |e| acc += e.estimate.x.k)
+                s.push(black_box(x), &mut |e| acc += e.values()[2])
                     .expect("valid samples");
             }
-            let ident = s
-                .finish(&mut |e| acc += e.estimate.x.k)
-                .expect("identified");
+            let ident = s.finish(&mut |e| acc += e.values()[2]).expect("identified");
             (acc, ident.record.samples)
         })
     });

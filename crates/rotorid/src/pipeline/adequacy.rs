@@ -130,6 +130,7 @@ pub(crate) fn of_model(rec: &Record, start: &RotorParams) -> Result<Adequacy, Pi
     let record = rec.for_refine();
     let options = RefineOptions {
         tolerance: REFIT_TOLERANCE,
+        unknowns: crate::refine::Unknowns::for_model(start.model()),
         ..RefineOptions::default()
     };
     let fit = refine(&record, start, &InitialState::default(), &options)?;
@@ -166,6 +167,13 @@ pub(crate) fn judge(ident: &mut Identification, rec: &Record, k: &Knowledge) {
         kz: r.kz * r.m / mz,
         a: k.a,
         unbalance: k.unbalance,
+        // a row's cross terms scale with that row's mass, as its direct ones
+        coupling: r.coupling.map(|c| crate::model::CrossCoupling {
+            cxz: c.cxz * r.m / mx,
+            kxz: c.kxz * r.m / mx,
+            czx: c.czx * r.m / mz,
+            kzx: c.kzx * r.m / mz,
+        }),
         ..r
     };
     let Ok(a) = of_model(rec, &rotor) else {

@@ -112,14 +112,6 @@ pub enum PipelineError {
         /// The unknowns without a nominal value, comma-separated.
         missing: String,
     },
-    /// The method has no identifier of this model (yet).
-    #[error("--method {method} has no identifier of the {model} model: use --method refine")]
-    ModelNotAvailable {
-        /// The method.
-        method: &'static str,
-        /// The model.
-        model: &'static str,
-    },
     /// `--model auto` with a given start: the start is a rotor of one model.
     #[error("a given start is a {model} rotor: choose the model (jeffcott or cross_coupled) rather than auto")]
     GivenStartNeedsModel {

@@ -8,13 +8,14 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::identify::algebraic::{AlgebraicEstimate, Quadrature};
+use crate::identify::algebraic::Quadrature;
 use crate::model::RotorParams;
 use crate::parameter::{ModelKind, Parameter};
 
 use super::diagnostic::{Diagnostic, Directions};
 use super::method::MethodName;
 use super::record::SpeedSource;
+use super::session::SampleEstimate;
 
 /// Version of the serialised form; incremented on incompatible changes (3: `model`, the
 /// cross-coupled model's parameter names, `rotor` keyed by the model's parameters,
@@ -474,7 +475,7 @@ pub struct Identification {
     pub refine: Option<RefineDetail>,
     /// algebraic, from [`super::identify`]: the estimate at every sample (not serialised).
     #[serde(skip)]
-    pub estimates: Vec<AlgebraicEstimate>,
+    pub estimates: Vec<SampleEstimate>,
 }
 
 impl Identification {
@@ -494,18 +495,20 @@ impl Identification {
     }
 
     /// The one estimate of a batch method (modulating, refine) as a row of per-direction
-    /// values: m_x, cx, kx, m_z, cz, kz (refine: m in both m_x and m_z), `None` where not
-    /// determined, at the last sample; rcond per direction (modulating: of its normal
-    /// matrix; refine: 1 / condition number of the scaled Fisher information, 0 when
-    /// singular). `None` for the algebraic method, whose estimates are per sample.
+    /// values of its model ([`ModelKind::per_direction`]: Jeffcott m_x, cx, kx, m_z, cz,
+    /// kz; refine: m in both m_x and m_z), `None` where not determined or not estimated,
+    /// at the last sample; rcond per direction (modulating: of its normal matrix; refine:
+    /// 1 / condition number of the scaled Fisher information, 0 when singular). `None` for
+    /// the algebraic method, whose estimates are per sample.
     pub fn final_estimate(&self) -> Option<FinalEstimate> {
         let t_s = self.record.t_last_s;
-        let of = |p: Parameter| self.value(p);
+        let per_direction = self.model.per_direction();
         if let Some(m) = &self.modulating {
             if self.method == MethodName::Modulating {
                 return Some(FinalEstimate {
                     t_s,
-                    values: Parameter::PER_DIRECTION.map(of),
+                    model: self.model,
+                    values: per_direction.iter().map(|&p| self.value(p)).collect(),
                     rcond: m.rcond,
                 });
             }
@@ -517,7 +520,11 @@ impl Identification {
             .map_or(0.0, |c| 1.0 / c);
         Some(FinalEstimate {
             t_s,
-            values: Parameter::PER_DIRECTION.map(|p| of(p.physical())),
+            model: self.model,
+            values: per_direction
+                .iter()
+                .map(|&p| self.value(p.physical()))
+                .collect(),
             rcond: Directions { x: rcond, z: rcond },
         })
     }
@@ -529,12 +536,15 @@ impl Identification {
 }
 
 /// The one estimate of a batch method (see [`Identification::final_estimate`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FinalEstimate {
     /// The last sample's time \[s\].
     pub t_s: f64,
-    /// m_x \[kg\], cx \[N s/m\], kx \[N/m\], m_z, cz, kz; `None` where not determined.
-    pub values: [Option<f64>; 6],
+    /// The model whose parameters the values are.
+    pub model: ModelKind,
+    /// The values of `model.per_direction()` (Jeffcott: m_x \[kg\], cx \[N s/m\], kx
+    /// \[N/m\], m_z, cz, kz); `None` where not determined.
+    pub values: Vec<Option<f64>>,
     /// Reciprocal condition number per direction (dimensionless, [0, 1]).
     pub rcond: Directions<f64>,
 }

@@ -63,9 +63,9 @@ pub use session::{
 };
 pub use start::ALGEBRAIC_START_S;
 
-use crate::identify::algebraic::{AlgebraicEstimate, ConvergenceTracker};
-use crate::identify::modulating::ModulatingEstimate;
-use crate::parameter::Parameter;
+use crate::identify::algebraic::ParameterConvergence;
+use crate::identify::modulating::{CrossModulatingEstimate, ModulatingEstimate};
+use crate::parameter::{ModelKind, Parameter, Sign};
 
 use identification::finite;
 use refine_run::relative_error;
@@ -174,19 +174,23 @@ pub(crate) fn record_info(rec: &Record) -> RecordInfo {
     }
 }
 
-/// The per-direction parameters of an estimate with `values` (m_x, cx, kx, m_z, cz, kz),
-/// kept where `ok` (x, z).
+/// The per-direction parameters of an estimate of `model` with `values` (in the order of
+/// [`ModelKind::per_direction`]: Jeffcott m_x, cx, kx, m_z, cz, kz), kept where `ok`
+/// (x, z).
 fn per_direction(
     k: &Knowledge,
-    values: [f64; 6],
+    model: ModelKind,
+    values: &[f64],
     ok: [bool; 2],
     fill: impl Fn(usize, &mut ParameterResult),
 ) -> Vec<ParameterResult> {
-    Parameter::PER_DIRECTION
+    let half = model.per_direction().len() / 2;
+    model
+        .per_direction()
         .iter()
         .enumerate()
         .map(|(i, &p)| {
-            let determined = ok[i / 3] && values[i].is_finite() && physical(p, values[i]);
+            let determined = ok[i / half] && values[i].is_finite() && physical(p, values[i]);
             let value = determined.then_some(values[i]);
             let truth = k.truth_of(p);
             let mut r = ParameterResult {
@@ -203,12 +207,13 @@ fn per_direction(
         .collect()
 }
 
-/// Inside the model's physical range: m, k > 0, c >= 0.
+/// Inside the model's physical range: m and the direct stiffness > 0, the direct damping
+/// >= 0, a cross-coupled coefficient any value ([`Parameter::sign`]).
 pub(crate) fn physical(p: Parameter, v: f64) -> bool {
-    match p.physical() {
-        Parameter::M | Parameter::Kx | Parameter::Kz => v > 0.0,
-        Parameter::Cx | Parameter::Cz => v >= 0.0,
-        _ => true,
+    match p.sign() {
+        Sign::Positive => v > 0.0,
+        Sign::NonNegative => v >= 0.0,
+        Sign::Any => true,
     }
 }
 
@@ -228,37 +233,108 @@ fn unphysical(params: &[ParameterResult]) -> Vec<Diagnostic> {
         .collect()
 }
 
-/// The rotor of per-direction results, when all are determined (m: mean of m_x, m_z).
-fn rotor_of(k: &Knowledge, params: &[ParameterResult]) -> Option<RotorSummary> {
-    let v: Vec<f64> = params.iter().map(|r| r.value).collect::<Option<_>>()?;
-    Some(RotorSummary::of(&crate::model::RotorParams {
-        m: 0.5 * (v[0] + v[3]),
-        cx: v[1],
-        kx: v[2],
-        cz: v[4],
-        kz: v[5],
+/// The rotor of per-direction results of `model`, when all are determined (m: mean of m_x,
+/// m_z).
+fn rotor_of(k: &Knowledge, model: ModelKind, params: &[ParameterResult]) -> Option<RotorSummary> {
+    let mut p = crate::model::RotorParams {
+        m: f64::NAN,
+        cx: f64::NAN,
+        kx: f64::NAN,
+        cz: f64::NAN,
+        kz: f64::NAN,
         a: k.a,
         unbalance: k.unbalance,
-        coupling: None,
-    }))
+        coupling: (model == ModelKind::CrossCoupled).then(Default::default),
+    };
+    let mut masses = 0.0;
+    for r in params {
+        let v = r.value?;
+        match r.parameter {
+            Parameter::MX | Parameter::MZ => masses += 0.5 * v,
+            q => p.set(q, v),
+        }
+    }
+    p.m = masses;
+    Some(RotorSummary::of(&p))
 }
 
+/// The modulating identifier's result, of either model: values and standard errors in the
+/// order of [`ModelKind::per_direction`].
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ModulatingSummary {
+    pub model: ModelKind,
+    pub values: Vec<f64>,
+    pub std_errors: Vec<f64>,
+    pub rcond: [f64; 2],
+    pub t: f64,
+    pub window_s: f64,
+    pub hop_s: f64,
+    pub windows: u64,
+    pub sigma_x: f64,
+    pub sigma_z: f64,
+    pub compensated: bool,
+}
+
+impl ModulatingSummary {
+    pub(crate) fn jeffcott(e: &ModulatingEstimate) -> Self {
+        Self {
+            model: ModelKind::Jeffcott,
+            values: e.values().to_vec(),
+            std_errors: e.std_errors().to_vec(),
+            rcond: [e.x.rcond, e.z.rcond],
+            t: e.t,
+            window_s: e.window_s,
+            hop_s: e.hop_s,
+            windows: e.windows,
+            sigma_x: e.sigma_x,
+            sigma_z: e.sigma_z,
+            compensated: e.compensated,
+        }
+    }
+
+    pub(crate) fn cross(e: &CrossModulatingEstimate) -> Self {
+        Self {
+            model: ModelKind::CrossCoupled,
+            values: e.values().to_vec(),
+            std_errors: e.std_errors().to_vec(),
+            rcond: [e.x.rcond, e.z.rcond],
+            t: e.t,
+            window_s: e.window_s,
+            hop_s: e.hop_s,
+            windows: e.windows,
+            sigma_x: e.sigma_x,
+            sigma_z: e.sigma_z,
+            compensated: e.compensated,
+        }
+    }
+
+    /// Whether each direction is well conditioned at `rcond_min`.
+    fn well_conditioned(&self, rcond_min: f64) -> [bool; 2] {
+        self.rcond.map(|r| r >= rcond_min && r > 0.0)
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn algebraic_identification(
     record: RecordInfo,
     k: &Knowledge,
     s: &AlgebraicSettings,
-    tracker: &ConvergenceTracker,
+    model: ModelKind,
+    results: &[ParameterConvergence],
     flagged: Directions<u64>,
-    last: Option<AlgebraicEstimate>,
+    last: Option<SampleEstimate>,
     windows: u64,
 ) -> Identification {
-    let results = tracker.results();
-    let values = results.map(|r| r.final_value.unwrap_or(f64::NAN));
+    let values: Vec<f64> = results
+        .iter()
+        .map(|r| r.final_value.unwrap_or(f64::NAN))
+        .collect();
+    let half = results.len() / 2;
     let ok = [
         results[0].final_value.is_some(),
-        results[3].final_value.is_some(),
+        results[half].final_value.is_some(),
     ];
-    let parameters = per_direction(k, values, ok, |i, r| {
+    let parameters = per_direction(k, model, &values, ok, |i, r| {
         r.t_s = results[i].final_t;
         // an estimate outside the physical range never counts as converged
         r.identification_time_s = results[i].identification_time.filter(|_| r.determined);
@@ -266,12 +342,12 @@ fn algebraic_identification(
     let mut diagnostics = unphysical(&parameters);
     // Settled only in the last half of the record, or never: the iterated integrals amplify
     // the noise as the record grows (docs/method.md section 3.8).
-    let half = record.t_first_s + 0.5 * (record.t_last_s - record.t_first_s);
+    let middle = record.t_first_s + 0.5 * (record.t_last_s - record.t_first_s);
     let unsettled: Vec<Parameter> = parameters
         .iter()
         .filter(|r| {
             !r.determined && r.estimate.is_some()
-                || r.determined && r.identification_time_s.is_none_or(|t| t > half)
+                || r.determined && r.identification_time_s.is_none_or(|t| t > middle)
         })
         .map(|r| r.parameter)
         .collect();
@@ -297,12 +373,12 @@ fn algebraic_identification(
     Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Algebraic,
-        model: crate::parameter::ModelKind::Jeffcott,
+        model,
         model_selection: None,
         input: None,
         scenario: None,
         record,
-        rotor: rotor_of(k, &parameters),
+        rotor: rotor_of(k, model, &parameters),
         parameters,
         covariance: None,
         noise: None,
@@ -317,11 +393,11 @@ fn algebraic_identification(
             flagged,
             final_time_s: Directions {
                 x: results[0].final_t,
-                z: results[3].final_t,
+                z: results[half].final_t,
             },
             last_rcond: Directions {
-                x: last.map_or(0.0, |e| e.x.rcond),
-                z: last.map_or(0.0, |e| e.z.rcond),
+                x: last.map_or(0.0, |e| e.rcond[0]),
+                z: last.map_or(0.0, |e| e.rcond[1]),
             },
         }),
         modulating: None,
@@ -331,15 +407,15 @@ fn algebraic_identification(
 }
 
 /// The modulating identifier's figures.
-pub(crate) fn modulating_detail(e: &ModulatingEstimate, rcond_min: f64) -> ModulatingDetail {
+pub(crate) fn modulating_detail(e: &ModulatingSummary, rcond_min: f64) -> ModulatingDetail {
     ModulatingDetail {
         window_s: e.window_s,
         hop_s: e.hop_s,
         windows: e.windows,
         rcond_min,
         rcond: Directions {
-            x: e.x.rcond,
-            z: e.z.rcond,
+            x: e.rcond[0],
+            z: e.rcond[1],
         },
         t_s: e.t,
         compensated: e.compensated,
@@ -352,33 +428,35 @@ fn modulating_identification(
     record: RecordInfo,
     k: &Knowledge,
     s: &ModulatingSettings,
-    e: &ModulatingEstimate,
+    e: &ModulatingSummary,
     bound: Result<(crate::refine::Crb, identification::CrbAt), PipelineError>,
 ) -> Identification {
     let rcond_min = s.config.rcond_min;
     let ok = e.well_conditioned(rcond_min);
-    let std = e.std_errors();
-    let values = e.values();
+    let std = &e.std_errors;
+    let values = &e.values;
+    let half = values.len() / 2;
     let crb_of = |p: Parameter| -> Option<f64> {
         let (b, _) = bound.as_ref().ok()?;
         finite(b.get(p.physical().name())?.std_dev)
     };
-    let parameters = per_direction(k, values, ok, |i, r| {
-        if ok[i / 3] {
+    let parameters = per_direction(k, e.model, values, ok, |i, r| {
+        if ok[i / half] {
             r.std_error = finite(std[i]);
             r.relative_std_error = finite(std[i] / values[i].abs());
             r.t_s = Some(e.t);
         }
         r.crb = crb_of(r.parameter);
     });
-    let mut diagnostics: Vec<Diagnostic> = [(Direction::X, e.x), (Direction::Z, e.z)]
+    let mut diagnostics: Vec<Diagnostic> = [(Direction::X, e.rcond[0]), (Direction::Z, e.rcond[1])]
         .iter()
-        .filter(|(_, d)| !d.well_conditioned(rcond_min))
-        .map(|&(direction, d)| {
-            Diagnostic::new(if d.rcond > 0.0 {
+        .zip(ok)
+        .filter(|(_, ok)| !ok)
+        .map(|(&(direction, rcond), _)| {
+            Diagnostic::new(if rcond > 0.0 {
                 Finding::DirectionIllConditioned {
                     direction,
-                    rcond: d.rcond,
+                    rcond,
                     rcond_min,
                 }
             } else {
@@ -397,12 +475,12 @@ fn modulating_identification(
     Identification {
         schema: IDENTIFICATION_SCHEMA,
         method: MethodName::Modulating,
-        model: crate::parameter::ModelKind::Jeffcott,
+        model: e.model,
         model_selection: None,
         input: None,
         scenario: None,
         record,
-        rotor: rotor_of(k, &parameters),
+        rotor: rotor_of(k, e.model, &parameters),
         parameters,
         covariance: None,
         noise: Some(Noise {

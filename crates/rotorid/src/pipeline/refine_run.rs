@@ -423,10 +423,12 @@ fn fit(
         adequacy,
         diagnostics,
         algebraic: None,
-        modulating: found
-            .modulating
-            .as_ref()
-            .map(|e| modulating_detail(e, s.modulating.config.rcond_min)),
+        modulating: found.modulating.as_ref().map(|e| {
+            modulating_detail(
+                &super::ModulatingSummary::jeffcott(e),
+                s.modulating.config.rcond_min,
+            )
+        }),
         refine: Some(RefineDetail {
             unknowns: u.parameters(model),
             start: found.start,
@@ -531,27 +533,34 @@ fn bound(
 pub(crate) fn modulating_bound(
     rec: &Record,
     k: &Knowledge,
-    values: [f64; 6],
+    model: ModelKind,
+    values: &[f64],
     sigma_x: f64,
     sigma_z: f64,
 ) -> Result<(crate::refine::Crb, CrbAt), PipelineError> {
-    let (rotor, known_ic, at) = match true_rotor(k, ModelKind::Jeffcott) {
+    let (rotor, known_ic, at) = match true_rotor(k, model) {
         Some((r, Some(ic))) if rec.grid().t0 == 0.0 => (r, Some(ic), CrbAt::Truth),
         Some((r, _)) => (r, None, CrbAt::TruthParameters),
-        None => (
-            RotorParams {
-                coupling: None,
-                m: 0.5 * (values[0] + values[3]),
-                cx: values[1],
-                kx: values[2],
-                cz: values[4],
-                kz: values[5],
+        None => {
+            let mut r = RotorParams {
+                coupling: (model == ModelKind::CrossCoupled).then(Default::default),
+                m: 0.0,
+                cx: f64::NAN,
+                kx: f64::NAN,
+                cz: f64::NAN,
+                kz: f64::NAN,
                 a: k.a,
                 unbalance: k.unbalance,
-            },
-            None,
-            CrbAt::Estimate,
-        ),
+            };
+            for (&p, &v) in model.per_direction().iter().zip(values) {
+                match p {
+                    // one mass: the mean of the two directions'
+                    Parameter::MX | Parameter::MZ => r.m += 0.5 * v,
+                    q => r.set(q, v),
+                }
+            }
+            (r, None, CrbAt::Estimate)
+        }
     };
     let record = rec.for_refine();
     let initial = match known_ic {
@@ -569,7 +578,7 @@ pub(crate) fn modulating_bound(
         &rotor,
         &initial,
         &record.experiment(),
-        &Unknowns::default(),
+        &Unknowns::for_model(model),
         sigma_x,
         sigma_z,
     )?;

@@ -10,10 +10,16 @@
 //! checked against the least-squares fit of all stamps so far. At the end the grid of all
 //! stamps is compared with the one used ([`Finding::TimeGridDrift`]).
 
-use crate::identify::algebraic::{AlgebraicEstimate, ConvergenceTracker, RestartingIdentifier};
-use crate::identify::modulating::ModulatingIdentifier;
+use crate::identify::algebraic::{
+    AlgebraicError, AlgebraicEstimate, ConvergenceTracker, CrossAlgebraicEstimate,
+    CrossAlgebraicIdentifier, ParameterConvergence, RestartingIdentifier,
+};
+use crate::identify::modulating::{
+    CrossModulatingIdentifier, ModulatingError, ModulatingIdentifier,
+};
 use crate::identify::Measurement;
 use crate::model::{SpeedProfile, SpeedState};
+use crate::parameter::{ModelKind, Parameter};
 
 use super::diagnostic::{Diagnostic, Directions, Finding};
 use super::error::PipelineError;
@@ -28,6 +34,9 @@ pub const DEFAULT_GRID_HEAD: usize = 4096;
 /// Fewest samples the algebraic identifier accepts: its 3x3 system can first be well
 /// conditioned at the 4th sample (tau = 3 dt) with every quadrature rule.
 pub const ALGEBRAIC_MIN_SAMPLES: usize = 4;
+/// Fewest samples the cross-coupled algebraic identifier accepts: its 5x5 system is
+/// singular before the sixth sample (A(t_0) = 0, one more integral per row).
+pub const CROSS_ALGEBRAIC_MIN_SAMPLES: usize = 6;
 /// Relative difference between the grid of all stamps and the one used above which a
 /// stream warns ([`Finding::TimeGridDrift`]): estimates move by about twice it.
 pub const GRID_DRIFT_LIMIT: f64 = 1e-6;
@@ -74,33 +83,166 @@ impl Default for Timing {
     }
 }
 
-/// An estimate of the algebraic identifier at one sample: `estimate.t` is the sample's
-/// stamp; `well_conditioned` per direction (x, z): the values of an ill-conditioned
-/// direction must not be used.
+/// An estimate of the algebraic identifier at one sample, of either model: the values of
+/// [`ModelKind::per_direction`] (Jeffcott: m_x, cx, kx, m_z, cz, kz; cross-coupled: m_x,
+/// cxx, cxz, kxx, kxz, m_z, czx, czz, kzx, kzz), the x direction's first half;
+/// `well_conditioned` per direction (x, z): the values of an ill-conditioned direction
+/// must not be used.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SampleEstimate {
-    /// The estimate.
-    pub estimate: AlgebraicEstimate,
-    /// Whether each direction's 3x3 system is well conditioned.
+    /// The sample's stamp \[s\].
+    pub t: f64,
+    /// The model whose parameters the values are.
+    pub model: ModelKind,
+    values: [f64; 10],
+    /// Reciprocal condition number of each direction's system (x, z), in [0, 1].
+    pub rcond: [f64; 2],
+    /// Whether each direction's system is well conditioned.
     pub well_conditioned: [bool; 2],
     /// The restart window the estimate comes from (0 without restarts; see
     /// [`AlgebraicSettings::restart_s`](super::AlgebraicSettings::restart_s)).
     pub window: u64,
 }
 
+impl SampleEstimate {
+    /// The Jeffcott identifier's estimate `e` at threshold `rcond_min`.
+    pub fn jeffcott(e: &AlgebraicEstimate, rcond_min: f64, window: u64) -> Self {
+        let v = e.values();
+        Self {
+            t: e.t,
+            model: ModelKind::Jeffcott,
+            values: std::array::from_fn(|i| v.get(i).copied().unwrap_or(f64::NAN)),
+            rcond: [e.x.rcond, e.z.rcond],
+            well_conditioned: e.well_conditioned(rcond_min),
+            window,
+        }
+    }
+
+    /// The cross-coupled identifier's estimate `e` at threshold `rcond_min`.
+    pub fn cross(e: &CrossAlgebraicEstimate, rcond_min: f64, window: u64) -> Self {
+        Self {
+            t: e.t,
+            model: ModelKind::CrossCoupled,
+            values: e.values(),
+            rcond: [e.x.rcond, e.z.rcond],
+            well_conditioned: e.well_conditioned(rcond_min),
+            window,
+        }
+    }
+
+    /// The parameters of [`values`](Self::values), in order.
+    pub fn parameters(&self) -> &'static [Parameter] {
+        self.model.per_direction()
+    }
+
+    /// Every value, ill-conditioned or not (NaN where the system was singular), in the
+    /// order of [`parameters`](Self::parameters) (kg, N s/m, N/m).
+    pub fn values(&self) -> &[f64] {
+        &self.values[..self.model.per_direction().len()]
+    }
+
+    /// Value `i` where its direction is well conditioned and it is finite: what the
+    /// estimates table writes.
+    pub fn usable(&self, i: usize) -> Option<f64> {
+        let v = *self.values().get(i)?;
+        let half = self.values().len() / 2;
+        (self.well_conditioned[i / half] && v.is_finite()).then_some(v)
+    }
+}
+
+/// The algebraic identifier and its convergence tracker, of the model identified.
+enum AlgebraicEngine {
+    Jeffcott(Box<RestartingIdentifier>, Box<ConvergenceTracker>),
+    Cross(
+        Box<RestartingIdentifier<CrossAlgebraicIdentifier>>,
+        Box<ConvergenceTracker<10>>,
+    ),
+}
+
+impl AlgebraicEngine {
+    /// Take `m`; the estimate at stamp `t`, also noted by the tracker.
+    #[inline]
+    fn push(
+        &mut self,
+        m: &Measurement,
+        t: f64,
+        rcond_min: f64,
+    ) -> Result<SampleEstimate, AlgebraicError> {
+        Ok(match self {
+            AlgebraicEngine::Jeffcott(id, tracker) => {
+                let w = id.push(m)?;
+                let mut e = w.estimate;
+                e.t = t;
+                tracker.push(&e);
+                SampleEstimate::jeffcott(&e, rcond_min, w.window)
+            }
+            AlgebraicEngine::Cross(id, tracker) => {
+                let w = id.push(m)?;
+                let mut e = w.estimate;
+                e.t = t;
+                tracker.push_cross(&e);
+                SampleEstimate::cross(&e, rcond_min, w.window)
+            }
+        })
+    }
+
+    fn windows(&self) -> u64 {
+        match self {
+            AlgebraicEngine::Jeffcott(id, _) => id.windows(),
+            AlgebraicEngine::Cross(id, _) => id.windows(),
+        }
+    }
+
+    fn results(&self) -> Vec<ParameterConvergence> {
+        match self {
+            AlgebraicEngine::Jeffcott(_, t) => t.results().to_vec(),
+            AlgebraicEngine::Cross(_, t) => t.results().to_vec(),
+        }
+    }
+
+    fn model(&self) -> ModelKind {
+        match self {
+            AlgebraicEngine::Jeffcott(..) => ModelKind::Jeffcott,
+            AlgebraicEngine::Cross(..) => ModelKind::CrossCoupled,
+        }
+    }
+}
+
+/// The modulating identifier of the model identified.
+enum ModulatingEngine {
+    Jeffcott(Box<ModulatingIdentifier>),
+    Cross(Box<CrossModulatingIdentifier>),
+}
+
+impl ModulatingEngine {
+    #[inline]
+    fn push(&mut self, m: &Measurement) -> Result<(), ModulatingError> {
+        match self {
+            ModulatingEngine::Jeffcott(id) => id.push(m),
+            ModulatingEngine::Cross(id) => id.push(m),
+        }
+    }
+
+    fn finish(&self) -> Result<super::ModulatingSummary, ModulatingError> {
+        Ok(match self {
+            ModulatingEngine::Jeffcott(id) => super::ModulatingSummary::jeffcott(&id.finish()?),
+            ModulatingEngine::Cross(id) => super::ModulatingSummary::cross(&id.finish()?),
+        })
+    }
+}
+
 enum Engine {
     Algebraic {
-        id: Box<RestartingIdentifier>,
-        tracker: Box<ConvergenceTracker>,
+        id: AlgebraicEngine,
         settings: AlgebraicSettings,
         flagged: Directions<u64>,
-        last: Option<AlgebraicEstimate>,
-        keep: Option<Vec<AlgebraicEstimate>>,
+        last: Option<SampleEstimate>,
+        keep: Option<Vec<SampleEstimate>>,
         /// The first [`ALGEBRAIC_ADEQUACY_SAMPLES`] samples, for the adequacy test.
         kept: Kept,
     },
     Modulating {
-        id: Box<ModulatingIdentifier>,
+        id: ModulatingEngine,
         /// The samples, for the Cramer-Rao bound and the adequacy test; the first
         /// [`MODULATING_CRB_MAX_SAMPLES`] of a longer record.
         kept: Kept,
@@ -148,6 +290,8 @@ impl Kept {
 pub struct Session {
     knowledge: Knowledge,
     method: Method,
+    /// The model identified (algebraic and modulating; refine chooses its own).
+    model: ModelKind,
     profile: Option<SpeedProfile>,
     timing: Timing,
     /// The grid in use, once known.
@@ -200,12 +344,6 @@ impl Session {
             Method::Refine(_) => None,
         }
         .unwrap_or(knowledge.model);
-        if model != crate::parameter::ModelKind::Jeffcott && !matches!(method, Method::Refine(_)) {
-            return Err(PipelineError::ModelNotAvailable {
-                method: method.name().as_str(),
-                model: model.name(),
-            });
-        }
         let grid = match timing {
             Timing::Grid { grid, .. } => Some(grid),
             Timing::Fit { .. } => None,
@@ -213,6 +351,7 @@ impl Session {
         Ok(Self {
             knowledge: *knowledge,
             method: *method,
+            model,
             profile,
             timing,
             grid,
@@ -240,6 +379,12 @@ impl Session {
             keep.get_or_insert_with(Vec::new);
         }
         self.keep = true;
+    }
+
+    /// The model identified: the method's `model`, else the knowledge's (refine may end
+    /// in another when it chooses, see [`Identification::model`]).
+    pub fn model(&self) -> ModelKind {
+        self.model
     }
 
     /// Samples pushed so far.
@@ -403,14 +548,19 @@ impl Session {
         self.engine = Some(match &self.method {
             Method::Algebraic(s) => {
                 let config = s.config()?;
+                let period = s.restart_samples(grid.dt)?;
+                let id = match self.model {
+                    ModelKind::Jeffcott => AlgebraicEngine::Jeffcott(
+                        Box::new(RestartingIdentifier::new(known, grid.dt, config, period)?),
+                        Box::new(ConvergenceTracker::new(s.tol, s.rcond_min)?),
+                    ),
+                    ModelKind::CrossCoupled => AlgebraicEngine::Cross(
+                        Box::new(RestartingIdentifier::cross(known, grid.dt, config, period)?),
+                        Box::new(ConvergenceTracker::cross(s.tol, s.rcond_min)?),
+                    ),
+                };
                 Engine::Algebraic {
-                    id: Box::new(RestartingIdentifier::new(
-                        known,
-                        grid.dt,
-                        config,
-                        s.restart_samples(grid.dt)?,
-                    )?),
-                    tracker: Box::new(ConvergenceTracker::new(s.tol, s.rcond_min)?),
+                    id,
                     settings: *s,
                     flagged: Directions::default(),
                     last: None,
@@ -419,7 +569,14 @@ impl Session {
                 }
             }
             Method::Modulating(s) => Engine::Modulating {
-                id: Box::new(ModulatingIdentifier::new(known, grid.dt, s.config)?),
+                id: match self.model {
+                    ModelKind::Jeffcott => ModulatingEngine::Jeffcott(Box::new(
+                        ModulatingIdentifier::new(known, grid.dt, s.config)?,
+                    )),
+                    ModelKind::CrossCoupled => ModulatingEngine::Cross(Box::new(
+                        CrossModulatingIdentifier::new(known, grid.dt, s.config)?,
+                    )),
+                },
                 kept: Kept::default(),
                 complete: true,
             },
@@ -462,32 +619,24 @@ impl Session {
         match self.engine.as_mut().expect("started") {
             Engine::Algebraic {
                 id,
-                tracker,
                 settings,
                 flagged,
                 last,
                 keep,
                 kept,
             } => {
-                let w = id.push(&m)?;
+                let e = id.push(&m, s.t.unwrap_or(tg), settings.rcond_min)?;
                 if kept.t.len() < ALGEBRAIC_ADEQUACY_SAMPLES {
                     kept.push(s.t.unwrap_or(tg), s);
                 }
-                let mut e = w.estimate;
-                e.t = s.t.unwrap_or(tg);
-                tracker.push(&e);
-                let ok = e.well_conditioned(settings.rcond_min);
+                let ok = e.well_conditioned;
                 flagged.x += u64::from(!ok[0]);
                 flagged.z += u64::from(!ok[1]);
                 *last = Some(e);
                 if let Some(k) = keep {
                     k.push(e);
                 }
-                on_estimate(&SampleEstimate {
-                    estimate: e,
-                    well_conditioned: ok,
-                    window: w.window,
-                });
+                on_estimate(&e);
             }
             Engine::Modulating { id, kept, complete } => {
                 id.push(&m)?;
@@ -536,21 +685,21 @@ impl Session {
         let mut ident = match self.engine.take().expect("started") {
             Engine::Algebraic {
                 id,
-                tracker,
                 settings,
                 flagged,
                 last,
                 keep,
                 kept,
             } => {
-                if self.done < ALGEBRAIC_MIN_SAMPLES {
+                if self.done < self.least() {
                     return Err(self.too_few(self.done));
                 }
                 let mut ident = super::algebraic_identification(
                     info,
                     &self.knowledge,
                     &settings,
-                    &tracker,
+                    id.model(),
+                    &id.results(),
                     flagged,
                     last,
                     id.windows(),
@@ -579,7 +728,8 @@ impl Session {
                     Ok(rec) if complete => super::refine_run::modulating_bound(
                         rec,
                         &self.knowledge,
-                        est.values(),
+                        est.model,
+                        &est.values,
                         est.sigma_x,
                         est.sigma_z,
                     ),
@@ -639,20 +789,25 @@ impl Session {
     }
 
     /// Fewest samples before the method can give anything: 4 for the algebraic
-    /// identifier, else 2 (the sampling period).
+    /// identifier (6 for the cross-coupled one), else 2 (the sampling period).
     fn least(&self) -> usize {
-        match self.method {
-            Method::Algebraic(_) => ALGEBRAIC_MIN_SAMPLES,
+        match (self.method, self.model) {
+            (Method::Algebraic(_), ModelKind::Jeffcott) => ALGEBRAIC_MIN_SAMPLES,
+            (Method::Algebraic(_), ModelKind::CrossCoupled) => CROSS_ALGEBRAIC_MIN_SAMPLES,
             _ if self.grid.is_some() => 1,
             _ => 2,
         }
     }
 
     fn too_few(&self, samples: usize) -> PipelineError {
-        let (needed, why) = match self.method {
-            Method::Algebraic(_) => (
+        let (needed, why) = match (self.method, self.model) {
+            (Method::Algebraic(_), ModelKind::Jeffcott) => (
                 ALGEBRAIC_MIN_SAMPLES,
                 "the 4th sample is the first at which the 3x3 system can be well conditioned",
+            ),
+            (Method::Algebraic(_), ModelKind::CrossCoupled) => (
+                CROSS_ALGEBRAIC_MIN_SAMPLES,
+                "the cross-coupled identifier's 5x5 system needs six samples",
             ),
             _ => (2, "two give the sampling period"),
         };

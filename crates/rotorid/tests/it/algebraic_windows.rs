@@ -82,8 +82,8 @@ fn restarts_track_a_change_the_single_identifier_averages_away() {
     let mut worst = 0.0f64;
     let mut n = 0;
     for e in restarted.estimates.iter().filter(|e| e.t >= 2.5 + 1e-9) {
-        if e.x.well_conditioned(1e-5) {
-            worst = worst.max((e.x.k / k2 - 1.0).abs());
+        if e.rcond[0] >= 1e-5 {
+            worst = worst.max((e.values()[2] / k2 - 1.0).abs());
             n += 1;
         }
     }

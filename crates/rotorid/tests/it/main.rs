@@ -13,6 +13,7 @@ mod analysis_cross;
 mod balance;
 mod cross_algebraic;
 mod cross_modulating;
+mod cross_pipeline;
 mod cross_reference;
 mod defects;
 mod identify_accuracy;

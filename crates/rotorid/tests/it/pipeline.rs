@@ -33,7 +33,18 @@ fn algebraic_equals_the_identifier_and_its_tracker() {
                 })
                 .collect()
         };
-        assert!(bits(&id.estimates) == bits(&direct), "{}", model.name);
+        let session_bits: Vec<u64> = id
+            .estimates
+            .iter()
+            .flat_map(|e| {
+                let v = e.values();
+                [
+                    e.t, v[0], v[1], v[2], e.rcond[0], v[3], v[4], v[5], e.rcond[1],
+                ]
+                .map(f64::to_bits)
+            })
+            .collect();
+        assert!(session_bits == bits(&direct), "{}", model.name);
         let mut tr = ConvergenceTracker::new(0.01, AlgebraicConfig::default().rcond_min).unwrap();
         direct.iter().for_each(|e| tr.push(e));
         for r in tr.results() {

@@ -48,10 +48,11 @@
 use serde::Serialize;
 
 use super::config::AlgebraicConfig;
+use super::cross_estimate::CrossAlgebraicEstimate;
 use super::error::AlgebraicError;
 use super::estimate::AlgebraicEstimate;
 use crate::model::check;
-use crate::parameter::Parameter;
+use crate::parameter::{ModelKind, Parameter};
 
 /// Default relative tolerance of the convergence band (1 %).
 pub const DEFAULT_TOLERANCE: f64 = 0.01;
@@ -229,9 +230,6 @@ impl Staircase {
 /// Instants the tracker holds back before it pushes them to its staircases together.
 const BLOCK: usize = 64;
 
-/// Staircases per tracker: a suffix-maxima and a suffix-minima one per parameter.
-const LANES: usize = 12;
-
 /// The positions of the set bits of `mask`, lowest first.
 fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
@@ -243,42 +241,45 @@ fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
     })
 }
 
-/// The last `n` instants, not yet in the staircases. Lane p of `v[i]` holds parameter p's
-/// value at instant i, lane 6 + p its negative (the minima staircase is the maxima one of
+/// The last `n` instants, not yet in the staircases. Lane 0 of `v[i][p]` holds parameter
+/// p's value at instant i, lane 1 its negative (the minima staircase is the maxima one of
 /// -v); -inf where the instant is not kept, which never survives a scan nor raises a
 /// maximum.
 #[derive(Debug, Clone)]
-struct Block {
+struct Block<const N: usize> {
     t: [f64; BLOCK],
-    v: [[f64; LANES]; BLOCK],
+    v: [[[f64; 2]; N]; BLOCK],
     /// Bit i of `kept[p]`: instant i is kept for parameter p.
-    kept: [u64; 6],
+    kept: [u64; N],
     n: usize,
 }
 
-impl Block {
+impl<const N: usize> Block<N> {
     fn new() -> Self {
         Self {
             t: [0.0; BLOCK],
-            v: [[0.0; LANES]; BLOCK],
-            kept: [0; 6],
+            v: [[[0.0; 2]; N]; BLOCK],
+            kept: [0; N],
             n: 0,
         }
     }
 
-    /// Per lane: the instants whose value exceeds every later one (bit i) and the largest
-    /// value. One backward pass over the block for all twelve lanes at once (compare and
-    /// select per lane, no branch: the compiler keeps the lanes in vector registers).
+    /// Per parameter and lane: the instants whose value exceeds every later one (bit i)
+    /// and the largest value. One backward pass over the block for all 2N lanes at once
+    /// (compare and select per lane, no branch: the compiler keeps the lanes in vector
+    /// registers).
     #[inline]
-    fn scan(&self) -> ([u64; LANES], [f64; LANES]) {
-        let mut survivors = [0u64; LANES];
-        let mut later_max = [f64::NEG_INFINITY; LANES];
+    fn scan(&self) -> ([[u64; 2]; N], [[f64; 2]; N]) {
+        let mut survivors = [[0u64; 2]; N];
+        let mut later_max = [[f64::NEG_INFINITY; 2]; N];
         for i in (0..self.n).rev() {
             let row = &self.v[i];
-            for l in 0..LANES {
-                let above = row[l] > later_max[l];
-                survivors[l] |= u64::from(above) << i;
-                later_max[l] = if above { row[l] } else { later_max[l] };
+            for p in 0..N {
+                for l in 0..2 {
+                    let above = row[p][l] > later_max[p][l];
+                    survivors[p][l] |= u64::from(above) << i;
+                    later_max[p][l] = if above { row[p][l] } else { later_max[p][l] };
+                }
             }
         }
         (survivors, later_max)
@@ -359,20 +360,24 @@ impl Track {
     }
 }
 
-/// Streaming convergence summary of the six parameters (module docs). Memory is bounded by
-/// the stack capacity whatever the record length.
+/// Streaming convergence summary of the N per-direction parameters of an algebraic
+/// identifier (module docs): six for the Jeffcott rotor's ([`Parameter::PER_DIRECTION`]),
+/// ten for the cross-coupled rotor's ([`ConvergenceTracker::cross`]), the x direction's
+/// first half. Memory is bounded by the stack capacity whatever the record length.
 #[derive(Debug, Clone)]
-pub struct ConvergenceTracker {
+pub struct ConvergenceTracker<const N: usize = 6> {
     tol: f64,
     rcond_min: f64,
-    tracks: [Track; 6],
-    block: Box<Block>,
+    parameters: [Parameter; N],
+    tracks: [Track; N],
+    block: Box<Block<N>>,
     estimates: u64,
 }
 
-impl ConvergenceTracker {
-    /// A tracker with relative band `tol` (finite, >= 0) that ignores instants with
-    /// rcond < `rcond_min` (in [0, 1]), with the default stack capacity.
+impl ConvergenceTracker<6> {
+    /// A tracker of the Jeffcott identifier's six values with relative band `tol` (finite,
+    /// >= 0) that ignores instants with rcond < `rcond_min` (in [0, 1]), with the default
+    /// stack capacity.
     pub fn new(tol: f64, rcond_min: f64) -> Result<Self, AlgebraicError> {
         Self::with_capacity(tol, rcond_min, DEFAULT_STACK_CAPACITY)
     }
@@ -380,6 +385,48 @@ impl ConvergenceTracker {
     /// As [`new`](Self::new) with each of the 12 stacks capped at `capacity` entries
     /// (>= 2).
     pub fn with_capacity(
+        tol: f64,
+        rcond_min: f64,
+        capacity: usize,
+    ) -> Result<Self, AlgebraicError> {
+        Self::of(Parameter::PER_DIRECTION, tol, rcond_min, capacity)
+    }
+
+    /// The default tolerance ([`DEFAULT_TOLERANCE`]) and the identifier's `rcond_min`.
+    pub fn for_config(config: &AlgebraicConfig) -> Result<Self, AlgebraicError> {
+        Self::new(DEFAULT_TOLERANCE, config.rcond_min)
+    }
+
+    /// Take the next estimate (in time order). Flagged directions are skipped.
+    #[inline]
+    pub fn push(&mut self, e: &AlgebraicEstimate) {
+        self.push_values(e.t, &e.values(), e.well_conditioned(self.rcond_min));
+    }
+}
+
+impl ConvergenceTracker<10> {
+    /// A tracker of the cross-coupled identifier's ten values (m_x, cxx, cxz, kxx, kxz,
+    /// m_z, czx, czz, kzx, kzz), as [`ConvergenceTracker::new`].
+    pub fn cross(tol: f64, rcond_min: f64) -> Result<Self, AlgebraicError> {
+        let p = ModelKind::CrossCoupled.per_direction();
+        Self::of(
+            std::array::from_fn(|i| p[i]),
+            tol,
+            rcond_min,
+            DEFAULT_STACK_CAPACITY,
+        )
+    }
+
+    /// Take the next estimate (in time order). Flagged directions are skipped.
+    #[inline]
+    pub fn push_cross(&mut self, e: &CrossAlgebraicEstimate) {
+        self.push_values(e.t, &e.values(), e.well_conditioned(self.rcond_min));
+    }
+}
+
+impl<const N: usize> ConvergenceTracker<N> {
+    fn of(
+        parameters: [Parameter; N],
         tol: f64,
         rcond_min: f64,
         capacity: usize,
@@ -392,15 +439,11 @@ impl ConvergenceTracker {
         Ok(Self {
             tol,
             rcond_min,
+            parameters,
             tracks: std::array::from_fn(|_| Track::new(capacity)),
             block: Box::new(Block::new()),
             estimates: 0,
         })
-    }
-
-    /// The default tolerance ([`DEFAULT_TOLERANCE`]) and the identifier's `rcond_min`.
-    pub fn for_config(config: &AlgebraicConfig) -> Result<Self, AlgebraicError> {
-        Self::new(DEFAULT_TOLERANCE, config.rcond_min)
     }
 
     /// The relative tolerance.
@@ -418,20 +461,22 @@ impl ConvergenceTracker {
         self.estimates
     }
 
-    /// Take the next estimate (in time order). Flagged directions are skipped.
+    /// Take the values `v` at time `t` (in time order), the x direction's first half;
+    /// `ok`: whether each direction is well conditioned (a flagged direction is skipped).
     #[inline]
-    pub fn push(&mut self, e: &AlgebraicEstimate) {
+    fn push_values(&mut self, t: f64, v: &[f64; N], ok: [bool; 2]) {
         self.estimates += 1;
-        let ok = e.well_conditioned(self.rcond_min);
-        let v = e.values();
         let b = &mut *self.block;
         let i = b.n;
-        b.t[i] = e.t;
+        b.t[i] = t;
         for (p, track) in self.tracks.iter_mut().enumerate() {
-            let keep = ok[p / 3] && v[p].is_finite();
-            track.note_if(e.t, v[p], keep);
-            b.v[i][p] = if keep { v[p] } else { f64::NEG_INFINITY };
-            b.v[i][6 + p] = if keep { -v[p] } else { f64::NEG_INFINITY };
+            let keep = ok[p / (N / 2)] && v[p].is_finite();
+            track.note_if(t, v[p], keep);
+            b.v[i][p] = if keep {
+                [v[p], -v[p]]
+            } else {
+                [f64::NEG_INFINITY; 2]
+            };
             b.kept[p] |= u64::from(keep) << i;
         }
         b.n += 1;
@@ -445,8 +490,14 @@ impl ConvergenceTracker {
         let b = &mut *self.block;
         let (survivors, top) = b.scan();
         for (p, track) in self.tracks.iter_mut().enumerate() {
-            for (stairs, l) in [(&mut track.max, p), (&mut track.min, 6 + p)] {
-                stairs.push_survivors(&b.t, |i| b.v[i][l], b.kept[p], survivors[l], top[l]);
+            for (stairs, l) in [(&mut track.max, 0), (&mut track.min, 1)] {
+                stairs.push_survivors(
+                    &b.t,
+                    |i| b.v[i][p][l],
+                    b.kept[p],
+                    survivors[p][l],
+                    top[p][l],
+                );
             }
             b.kept[p] = 0;
         }
@@ -460,7 +511,7 @@ impl ConvergenceTracker {
         c
     }
 
-    /// Entries held in the 12 staircases now (each at most the capacity): the tracker's
+    /// Entries held in the 2N staircases now (each at most the capacity): the tracker's
     /// memory is about 32 bytes times this.
     pub fn stack_entries(&self) -> usize {
         self.flushed()
@@ -473,14 +524,14 @@ impl ConvergenceTracker {
     /// The summary of one parameter so far; `None` for a parameter the per-direction
     /// identifier does not estimate (m, a, mud, alpha).
     pub fn result(&self, p: Parameter) -> Option<ParameterConvergence> {
-        let i = p.direction_index()?;
+        let i = self.parameters.iter().position(|&q| q == p)?;
         Some(self.flushed().tracks[i].result(p, self.tol))
     }
 
-    /// The summaries of all six, in [`Parameter::PER_DIRECTION`] order.
-    pub fn results(&self) -> [ParameterConvergence; 6] {
+    /// The summaries of all N, in the identifier's order ([`ModelKind::per_direction`]).
+    pub fn results(&self) -> [ParameterConvergence; N] {
         let all = self.flushed();
-        std::array::from_fn(|i| all.tracks[i].result(Parameter::PER_DIRECTION[i], self.tol))
+        std::array::from_fn(|i| all.tracks[i].result(self.parameters[i], self.tol))
     }
 }
 

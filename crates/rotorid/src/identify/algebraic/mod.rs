@@ -57,4 +57,4 @@ pub use estimate::{AlgebraicEstimate, DirectionEstimate};
 pub use identifier::AlgebraicIdentifier;
 pub use quadrature::{Quadrature, RunningIntegrals, LEVELS};
 pub use scaled_solve::{solve_scaled, ScaledSolution};
-pub use windows::{RestartingIdentifier, WindowedEstimate, MIN_RESTART_SAMPLES};
+pub use windows::{Restartable, RestartingIdentifier, WindowedEstimate, MIN_RESTART_SAMPLES};

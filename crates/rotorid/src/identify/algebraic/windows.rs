@@ -20,10 +20,45 @@
 //! identifier, bit for bit.
 
 use super::config::AlgebraicConfig;
+use super::cross::CrossAlgebraicIdentifier;
+use super::cross_estimate::CrossAlgebraicEstimate;
 use super::error::AlgebraicError;
 use super::estimate::AlgebraicEstimate;
 use super::identifier::AlgebraicIdentifier;
 use crate::identify::{Known, Measurement};
+
+/// A streaming algebraic identifier that can start over: the Jeffcott rotor's
+/// ([`AlgebraicIdentifier`]) or the cross-coupled rotor's ([`CrossAlgebraicIdentifier`]).
+pub trait Restartable: Clone {
+    /// Its estimate at one sample.
+    type Estimate: Copy;
+    /// Take the next measurement (on an error nothing changes).
+    fn push(&mut self, m: &Measurement) -> Result<Self::Estimate, AlgebraicError>;
+    /// Start over: the next measurement becomes t_0.
+    fn reset(&mut self);
+}
+
+impl Restartable for AlgebraicIdentifier {
+    type Estimate = AlgebraicEstimate;
+    #[inline]
+    fn push(&mut self, m: &Measurement) -> Result<AlgebraicEstimate, AlgebraicError> {
+        AlgebraicIdentifier::push(self, m)
+    }
+    fn reset(&mut self) {
+        AlgebraicIdentifier::reset(self)
+    }
+}
+
+impl Restartable for CrossAlgebraicIdentifier {
+    type Estimate = CrossAlgebraicEstimate;
+    #[inline]
+    fn push(&mut self, m: &Measurement) -> Result<CrossAlgebraicEstimate, AlgebraicError> {
+        CrossAlgebraicIdentifier::push(self, m)
+    }
+    fn reset(&mut self) {
+        CrossAlgebraicIdentifier::reset(self)
+    }
+}
 
 /// Fewest samples in a restart period: each window must hold at least two half-periods of
 /// two samples (an estimate needs tau > 0).
@@ -31,9 +66,9 @@ pub const MIN_RESTART_SAMPLES: u64 = 4;
 
 /// One estimate and the window it comes from (module doc).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WindowedEstimate {
+pub struct WindowedEstimate<E = AlgebraicEstimate> {
     /// The estimate.
-    pub estimate: AlgebraicEstimate,
+    pub estimate: E,
     /// Index of the window (0 = the one started at the first sample); always 0 without
     /// restarts.
     pub window: u64,
@@ -41,10 +76,11 @@ pub struct WindowedEstimate {
     pub age: u64,
 }
 
-/// The algebraic identifier restarted on a schedule (module doc).
+/// The algebraic identifier restarted on a schedule (module doc): the Jeffcott rotor's by
+/// default, the cross-coupled rotor's with [`RestartingIdentifier::cross`].
 #[derive(Debug, Clone)]
-pub struct RestartingIdentifier {
-    ids: [AlgebraicIdentifier; 2],
+pub struct RestartingIdentifier<I: Restartable = AlgebraicIdentifier> {
+    ids: [I; 2],
     /// Half the restart period \[samples\]; `None`: never restart.
     half: Option<u64>,
     /// Samples accepted.
@@ -60,6 +96,26 @@ impl RestartingIdentifier {
         config: AlgebraicConfig,
         period: Option<u64>,
     ) -> Result<Self, AlgebraicError> {
+        Self::of(AlgebraicIdentifier::new(known, dt, config)?, period)
+    }
+}
+
+impl RestartingIdentifier<CrossAlgebraicIdentifier> {
+    /// The cross-coupled identifier restarted every `period` samples, as
+    /// [`RestartingIdentifier::new`].
+    pub fn cross(
+        known: Known,
+        dt: f64,
+        config: AlgebraicConfig,
+        period: Option<u64>,
+    ) -> Result<Self, AlgebraicError> {
+        Self::of(CrossAlgebraicIdentifier::new(known, dt, config)?, period)
+    }
+}
+
+impl<I: Restartable> RestartingIdentifier<I> {
+    /// `id` restarted every `period` samples.
+    fn of(id: I, period: Option<u64>) -> Result<Self, AlgebraicError> {
         let half = match period {
             Some(p) if p < MIN_RESTART_SAMPLES || p % 2 != 0 => {
                 return Err(AlgebraicError::RestartPeriod {
@@ -70,7 +126,6 @@ impl RestartingIdentifier {
             Some(p) => Some(p / 2),
             None => None,
         };
-        let id = AlgebraicIdentifier::new(known, dt, config)?;
         Ok(Self {
             ids: [id.clone(), id],
             half,
@@ -93,7 +148,10 @@ impl RestartingIdentifier {
 
     /// Take the next measurement; the estimate of the window that reports it (module doc).
     /// On an error (see [`AlgebraicIdentifier::push`]) nothing changes.
-    pub fn push(&mut self, m: &Measurement) -> Result<WindowedEstimate, AlgebraicError> {
+    pub fn push(
+        &mut self,
+        m: &Measurement,
+    ) -> Result<WindowedEstimate<I::Estimate>, AlgebraicError> {
         let Some(h) = self.half else {
             let estimate = self.ids[0].push(m)?;
             self.i += 1;
