@@ -1,6 +1,7 @@
 //! A record as the caller holds it: borrowed columns (numpy arrays are read in place), and
 //! the estimates table that comes back, one column per quantity.
 
+use rotorid::parameter::ModelKind;
 use rotorid::pipeline::{FinalEstimate, Sample, SampleEstimate};
 use rotorid::SpeedState;
 
@@ -117,22 +118,48 @@ impl<'a> Columns<'a> {
 /// The speed columns' names.
 pub const SPEED_NAMES: [&str; 3] = ["phi", "phi_dot", "phi_ddot"];
 
-/// The estimates table's columns, as `rotorid identify --out` writes them.
+/// The estimates table's columns for the Jeffcott model, as `rotorid identify --out`
+/// writes them.
 pub const ESTIMATE_COLUMNS: [&str; 10] = [
     "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z", "window",
 ];
 
-/// Estimates, one row per estimate, in columns [`ESTIMATE_COLUMNS`]: t \[s\], m \[kg\],
-/// c \[N s/m\], k \[N/m\] per direction (NaN where the CLI leaves the field empty: an
-/// ill-conditioned direction, a value not determined), rcond per direction, and the
+/// The estimates table's columns for `model`: t, each per-direction parameter's column
+/// ([`rotorid::Parameter::column`]), rcond_x, rcond_z, window (as `rotorid identify
+/// --out` writes them).
+pub fn estimate_columns(model: ModelKind) -> Vec<&'static str> {
+    let mut c = vec!["t"];
+    c.extend(model.per_direction().iter().map(|p| p.column()));
+    c.extend(["rcond_x", "rcond_z", "window"]);
+    c
+}
+
+/// Estimates, one row per estimate, in columns [`estimate_columns`] of the model: t \[s\],
+/// the per-direction values \[kg, N s/m, N/m\] (NaN where the CLI leaves the field empty:
+/// an ill-conditioned direction, a value not determined), rcond per direction, and the
 /// algebraic estimate's restart window (0, 1, 2, ...; NaN on a batch method's row).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Estimates {
-    /// The columns, in the order of [`ESTIMATE_COLUMNS`].
-    pub columns: [Vec<f64>; 10],
+    /// The model whose parameters the values are.
+    pub model: ModelKind,
+    /// The columns, in the order of [`estimate_columns`].
+    pub columns: Vec<Vec<f64>>,
 }
 
 impl Estimates {
+    /// No row, in `model`'s columns.
+    pub fn new(model: ModelKind) -> Self {
+        Self {
+            model,
+            columns: vec![Vec::new(); estimate_columns(model).len()],
+        }
+    }
+
+    /// The columns' names.
+    pub fn names(&self) -> Vec<&'static str> {
+        estimate_columns(self.model)
+    }
+
     /// Rows.
     pub fn len(&self) -> usize {
         self.columns[0].len()
@@ -143,45 +170,27 @@ impl Estimates {
         self.len() == 0
     }
 
-    /// The algebraic estimate at one sample: m, c, k where well conditioned and finite.
+    /// The algebraic estimate at one sample: the values where well conditioned and finite.
     pub fn push_sample(&mut self, e: &SampleEstimate) {
-        let est = &e.estimate;
-        let [ok_x, ok_z] = e.well_conditioned;
-        let keep = |v: f64, ok: bool| if ok && v.is_finite() { v } else { f64::NAN };
-        let row = [
-            est.t,
-            keep(est.x.m, ok_x),
-            keep(est.x.c, ok_x),
-            keep(est.x.k, ok_x),
-            keep(est.z.m, ok_z),
-            keep(est.z.c, ok_z),
-            keep(est.z.k, ok_z),
-            est.x.rcond,
-            est.z.rcond,
-            // (exact: a window index is far below 2^53)
-            e.window as f64,
-        ];
-        self.push(row);
+        let n = e.values().len();
+        let mut row = Vec::with_capacity(n + 4);
+        row.push(e.t);
+        row.extend((0..n).map(|i| e.usable(i).unwrap_or(f64::NAN)));
+        // (exact: a window index is far below 2^53)
+        row.extend([e.rcond[0], e.rcond[1], e.window as f64]);
+        self.push(&row);
     }
 
     /// The one row of a batch method (modulating, refine).
     pub fn push_final(&mut self, f: &FinalEstimate) {
-        let v = f.values.map(|v| v.unwrap_or(f64::NAN));
-        self.push([
-            f.t_s,
-            v[0],
-            v[1],
-            v[2],
-            v[3],
-            v[4],
-            v[5],
-            f.rcond.x,
-            f.rcond.z,
-            f64::NAN,
-        ]);
+        let mut row = Vec::with_capacity(f.values.len() + 4);
+        row.push(f.t_s);
+        row.extend(f.values.iter().map(|v| v.unwrap_or(f64::NAN)));
+        row.extend([f.rcond.x, f.rcond.z, f64::NAN]);
+        self.push(&row);
     }
 
-    /// The rows of `other` after these.
+    /// The rows of `other` (of the same model) after these.
     pub fn append(&mut self, other: Estimates) {
         for (c, o) in self.columns.iter_mut().zip(other.columns) {
             if c.is_empty() {
@@ -192,9 +201,10 @@ impl Estimates {
         }
     }
 
-    fn push(&mut self, row: [f64; 10]) {
+    fn push(&mut self, row: &[f64]) {
+        debug_assert_eq!(row.len(), self.columns.len(), "a row of the table's model");
         for (c, v) in self.columns.iter_mut().zip(row) {
-            c.push(v);
+            c.push(*v);
         }
     }
 }

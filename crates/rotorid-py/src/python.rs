@@ -143,7 +143,7 @@ fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
 /// The estimates as a dict of numpy arrays (moved into numpy, not copied).
 fn estimates_dict(py: Python<'_>, e: Estimates) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    for (name, c) in ESTIMATE_COLUMNS.iter().zip(e.columns) {
+    for (name, c) in e.names().into_iter().zip(e.columns) {
         d.set_item(name, PyArray1::from_vec(py, c))?;
     }
     Ok(d)
@@ -731,5 +731,10 @@ fn rotorid_extension(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("UNKNOWNS", options::UNKNOWN_NAMES.to_vec())?;
     m.add("MODELS", options::MODEL_NAMES.to_vec())?;
     m.add("ESTIMATE_COLUMNS", ESTIMATE_COLUMNS.to_vec())?;
+    let by_model = PyDict::new(m.py());
+    for model in ModelKind::ALL {
+        by_model.set_item(model.name(), crate::columns::estimate_columns(model))?;
+    }
+    m.add("ESTIMATE_COLUMNS_BY_MODEL", by_model)?;
     Ok(())
 }

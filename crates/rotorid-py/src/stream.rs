@@ -119,7 +119,7 @@ impl Stream {
                  t with every chunk, or dt",
             ));
         }
-        let mut out = Estimates::default();
+        let mut out = Estimates::new(self.session.model());
         let mut sink = |e: &rotorid::pipeline::SampleEstimate| out.push_sample(e);
         for i in 0..c.len() {
             self.session.push(&c.sample(i), &mut sink)?;
@@ -187,7 +187,7 @@ impl Stream {
     /// Fit the grid over the stamps held back so far and identify them (a live
     /// acquisition that has paused); a no-op once started.
     pub fn start_now(&mut self) -> Result<Estimates, Error> {
-        let mut out = Estimates::default();
+        let mut out = Estimates::new(self.session.model());
         self.session.start_now(&mut |e| out.push_sample(e))?;
         Ok(out)
     }
@@ -195,7 +195,7 @@ impl Stream {
     /// The identification of every sample pushed, and the estimates not yet returned
     /// (algebraic: those of a head never started; modulating and refine: their one row).
     pub fn finish(self) -> Result<Identified, Error> {
-        let mut out = Estimates::default();
+        let mut out = Estimates::new(self.session.model());
         let ident = self.session.finish(&mut |e| out.push_sample(e))?;
         if let Some(f) = ident.final_estimate() {
             out.push_final(&f);

@@ -8,7 +8,9 @@ import json
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
+from conftest import run
 from pandas.testing import assert_frame_equal
 
 import rotorid
@@ -161,3 +163,42 @@ def test_session_takes_the_model(cross_record, model):
     assert live.model == "cross_coupled"
     d, b = live.to_dict(), batch.to_dict()
     assert d["rotor"] == b["rotor"] and d["model_selection"] == b["model_selection"]
+
+
+def test_modulating_and_algebraic_of_the_cross_coupled_model(cross_record, cross, tmp_path, cli):
+    # the per-row identifiers of the cross-coupled model: parameters and estimates named
+    # by the model, the same numbers as `rotorid identify --model cross_coupled`
+    truth = dict(m_x=14.29, m_z=14.29, **{k: CROSS[k] for k in COEFFS})
+    mod = rotorid.identify(cross_record, cross, method="modulating", model="cross_coupled")
+    assert mod.model == "cross_coupled"
+    assert list(mod.params.index) == ["m_x", "cxx", "cxz", "kxx", "kxz",
+                                      "m_z", "czx", "czz", "kzx", "kzz"]
+    z = (mod.params["value"] - pd.Series(truth)) / mod.params["std_error"]
+    assert (z.abs() < 4).all(), z
+    assert list(mod.estimates.columns) == rotorid.ESTIMATE_COLUMNS_BY_MODEL["cross_coupled"]
+    assert len(mod.estimates) == 1
+    assert mod.estimates["kxz"].iloc[0] == mod.params.loc["kxz", "value"]
+    alg = rotorid.identify(cross_record.iloc[:1001], cross, method="algebraic",
+                           model="cross_coupled")
+    assert list(alg.estimates.columns) == rotorid.ESTIMATE_COLUMNS_BY_MODEL["cross_coupled"]
+    assert len(alg.estimates) == 1001
+    # a session streams the same estimates, chunk by chunk
+    s = rotorid.Session(cross, method="algebraic", dt=1e-4, model="cross_coupled")
+    chunks = [s.push(c.x, c.z, phi=c.phi, phi_dot=c.phi_dot, phi_ddot=c.phi_ddot)
+              for c in (cross_record.iloc[i:i + 250] for i in range(0, 1001, 250))]
+    live = s.finish()
+    assert all(list(c.columns) == list(alg.estimates.columns) for c in chunks)
+    assert_frame_equal(live.estimates, alg.estimates)
+    # the command line writes the same table
+    rec = tmp_path / "r.csv"
+    cross_record.iloc[:1001].to_csv(rec, index=False)
+    scenario = tmp_path / "s.toml"
+    rotor = "\n".join(f"{k} = {CROSS[k]!r}" for k in ["m", "a", "m_u", "d", "alpha_deg", *COEFFS])
+    scenario.write_text(f'[rotor]\nmodel = "cross_coupled"\n{rotor}\n'
+                        '[speed]\nkind = "constant"\nrpm = 1200.0\n')
+    out = tmp_path / "e.csv"
+    run(cli, "identify", str(rec), "--scenario", str(scenario), "--method", "algebraic",
+        "--model", "cross_coupled", "--out", str(out), "-q")
+    cli = pd.read_csv(out, float_precision="round_trip")
+    assert list(cli.columns) == list(alg.estimates.columns)
+    np.testing.assert_array_equal(cli.to_numpy(), alg.estimates.to_numpy())

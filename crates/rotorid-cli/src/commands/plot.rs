@@ -492,7 +492,7 @@ fn response_figure(title: &str, d: &ResponseData, window: Window) -> anyhow::Res
         .with_size(1600, 800))
 }
 
-/// Estimates, thinned: m, c, k of x then of z, as in [`crate::io::ParameterSet::to_array`].
+/// Estimates, thinned: m, c, k of x then of z, as in `ParameterSet::to_array`.
 struct EstimatesData {
     extent: Extent,
     curves: Vec<ColumnThinner>,
@@ -501,6 +501,14 @@ struct EstimatesData {
 
 fn read_estimates<R: Read>(name: &str, input: R, window: Window) -> anyhow::Result<EstimatesData> {
     let mut r = EstimatesReader::new(name, input)?;
+    if r.model() != rotorid::parameter::ModelKind::Jeffcott {
+        anyhow::bail!(
+            "{name}: an estimates file of the {} model (columns {}); plot draws the Jeffcott \
+             model's m, c, k per direction: read this file with pandas to plot its columns",
+            r.model(),
+            crate::io::estimates_csv::estimates_header(r.model()).join(",")
+        );
+    }
     let mut d = EstimatesData {
         extent: Extent::new(),
         curves: vec![ColumnThinner::new(COLUMNS, window); 6],
@@ -519,7 +527,10 @@ fn read_estimates<R: Read>(name: &str, input: R, window: Window) -> anyhow::Resu
             }
         }
         last_window = row.window;
-        for (i, v) in row.values.to_array().into_iter().enumerate() {
+        let Some(values) = row.jeffcott() else {
+            unreachable!("the reader's model was checked")
+        };
+        for (i, v) in values.to_array().into_iter().enumerate() {
             let v = v.unwrap_or(f64::NAN);
             d.curves[i].push(row.t, v);
             if inside && v.is_finite() {

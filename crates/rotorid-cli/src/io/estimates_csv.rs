@@ -7,6 +7,14 @@
 //! s,kg,N s/m,N/m,kg,N s/m,N/m,1,1,-        (units, not written)
 //! ```
 //!
+//! The cross-coupled model's (`--model cross_coupled`; docs/method.md sections 3.10 and
+//! 4.8): per direction m and the four coefficients of that row, named as in the summary:
+//!
+//! ```text
+//! t,m_x,cxx,cxz,kxx,kxz,m_z,czx,czz,kzx,kzz,rcond_x,rcond_z,window
+//! s,kg,N s/m,N s/m,N/m,N/m,kg,N s/m,N s/m,N/m,N/m,1,1,-
+//! ```
+//!
 //! - `t` is the sample's time as read from the input.
 //! - `window` is the algebraic estimate's restart window (`--restart`; docs/method.md
 //!   section 3.9): 0, 1, 2, ... in the order they start, 0 throughout without restarts. A
@@ -23,6 +31,7 @@
 
 use std::io::{self, Read, Write};
 
+use rotorid::parameter::ModelKind;
 use rotorid_io::csv::columns::{
     check_length, csv_reader, finite_field, next_record, number_field, optional_field, CsvReader,
     Header,
@@ -32,7 +41,7 @@ use rotorid_io::csv::CsvError;
 
 use super::params::ParameterSet;
 
-/// The header `identify` writes.
+/// The header `identify` writes for the Jeffcott model.
 pub const ESTIMATES_HEADER: [&str; 10] = [
     "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z", "window",
 ];
@@ -42,28 +51,41 @@ pub const ESTIMATES_REQUIRED: [&str; 9] = [
     "t", "m_x", "c_x", "k_x", "m_z", "c_z", "k_z", "rcond_x", "rcond_z",
 ];
 
-/// `rows` as a Parquet file with the CSV's columns (optional DOUBLE: a withheld estimate is
-/// a null, where the CSV leaves the field empty); `file` names it in errors.
+/// The header `identify` writes for `model`: t, each per-direction parameter's column
+/// ([`rotorid::Parameter::column`]), rcond_x, rcond_z, window.
+pub fn estimates_header(model: ModelKind) -> Vec<&'static str> {
+    let mut h = vec!["t"];
+    h.extend(model.per_direction().iter().map(|p| p.column()));
+    h.extend(["rcond_x", "rcond_z", "window"]);
+    h
+}
+
+/// `rows` (all of one model) as a Parquet file with the CSV's columns (optional DOUBLE: a
+/// withheld estimate is a null, where the CSV leaves the field empty); `file` names it in
+/// errors.
 pub fn estimates_parquet(
     file: &str,
+    model: ModelKind,
     rows: &[EstimateRow],
 ) -> Result<Vec<u8>, rotorid_io::WriteError> {
     use rotorid_io::write::{parquet_columns_bytes, ParquetColumn};
+    let header = estimates_header(model);
+    let n = model.per_direction().len();
     let t: Vec<f64> = rows.iter().map(|r| r.t).collect();
-    let values: Vec<Vec<Option<f64>>> = (0..6)
-        .map(|k| rows.iter().map(|r| r.values.to_array()[k]).collect())
+    let values: Vec<Vec<Option<f64>>> = (0..n)
+        .map(|k| rows.iter().map(|r| r.values[k]).collect())
         .collect();
     let rcond_x: Vec<f64> = rows.iter().map(|r| r.rcond_x).collect();
     let rcond_z: Vec<f64> = rows.iter().map(|r| r.rcond_z).collect();
     // (a whole number, exact as a double: the column is a double like the others)
     let window: Vec<Option<f64>> = rows.iter().map(|r| r.window.map(|w| w as f64)).collect();
-    let mut columns = vec![(ESTIMATES_HEADER[0], ParquetColumn::Required(&t))];
+    let mut columns = vec![(header[0], ParquetColumn::Required(&t))];
     for (k, v) in values.iter().enumerate() {
-        columns.push((ESTIMATES_HEADER[1 + k], ParquetColumn::Optional(v)));
+        columns.push((header[1 + k], ParquetColumn::Optional(v)));
     }
-    columns.push((ESTIMATES_HEADER[7], ParquetColumn::Required(&rcond_x)));
-    columns.push((ESTIMATES_HEADER[8], ParquetColumn::Required(&rcond_z)));
-    columns.push((ESTIMATES_HEADER[9], ParquetColumn::Optional(&window)));
+    columns.push((header[n + 1], ParquetColumn::Required(&rcond_x)));
+    columns.push((header[n + 2], ParquetColumn::Required(&rcond_z)));
+    columns.push((header[n + 3], ParquetColumn::Optional(&window)));
     parquet_columns_bytes(file, &columns)
 }
 
@@ -72,8 +94,11 @@ pub fn estimates_parquet(
 pub struct EstimateRow {
     /// Time t [s].
     pub t: f64,
-    /// The estimates (kg, N s/m, N/m); `None` where the direction is not well conditioned.
-    pub values: ParameterSet<Option<f64>>,
+    /// The model whose parameters the values are.
+    pub model: ModelKind,
+    /// The estimates of `model.per_direction()` (kg, N s/m, N/m), the rest `None`; `None`
+    /// where the direction is not well conditioned or the value not determined.
+    pub values: [Option<f64>; 10],
     /// Reciprocal condition number of the x system (dimensionless, [0, 1]).
     pub rcond_x: f64,
     /// Reciprocal condition number of the z system (dimensionless, [0, 1]).
@@ -83,42 +108,76 @@ pub struct EstimateRow {
     pub window: Option<u64>,
 }
 
-/// Writes the estimates CSV (header first), one whole row per `write_all`.
+impl EstimateRow {
+    /// A row of `model` from its per-direction values (in the order of
+    /// `model.per_direction()`; extra values ignored).
+    pub fn new(
+        t: f64,
+        model: ModelKind,
+        values: &[Option<f64>],
+        rcond: [f64; 2],
+        window: Option<u64>,
+    ) -> Self {
+        let n = model.per_direction().len();
+        Self {
+            t,
+            model,
+            values: std::array::from_fn(|i| {
+                if i < n {
+                    values.get(i).copied().flatten()
+                } else {
+                    None
+                }
+            }),
+            rcond_x: rcond[0],
+            rcond_z: rcond[1],
+            window,
+        }
+    }
+
+    /// The Jeffcott model's six values (m_x, c_x, k_x, m_z, c_z, k_z); `None` for a row of
+    /// another model.
+    pub fn jeffcott(&self) -> Option<ParameterSet<Option<f64>>> {
+        (self.model == ModelKind::Jeffcott)
+            .then(|| ParameterSet::from_array(std::array::from_fn(|i| self.values[i])))
+    }
+}
+
+/// Writes the estimates CSV of one model (header first), one whole row per `write_all`.
 pub struct EstimatesWriter<W: Write> {
     out: W,
     scratch: Vec<u8>,
+    fields: Vec<Option<f64>>,
+    model: ModelKind,
 }
 
 impl<W: Write> EstimatesWriter<W> {
-    /// Write the header to `out`.
-    pub fn new(mut out: W) -> io::Result<Self> {
-        writeln!(out, "{}", ESTIMATES_HEADER.join(","))?;
+    /// Write `model`'s header ([`estimates_header`]) to `out`.
+    pub fn for_model(mut out: W, model: ModelKind) -> io::Result<Self> {
+        let header = estimates_header(model);
+        writeln!(out, "{}", header.join(","))?;
         Ok(Self {
             out,
             scratch: Vec::with_capacity(256),
+            fields: Vec::with_capacity(header.len()),
+            model,
         })
     }
 
-    /// Write one row.
+    /// Write one row (of the writer's model).
     pub fn write(&mut self, r: &EstimateRow) -> io::Result<()> {
-        let v = r.values;
-        write_row(
-            &mut self.out,
-            &mut self.scratch,
-            &[
-                Some(r.t),
-                v.m_x,
-                v.c_x,
-                v.k_x,
-                v.m_z,
-                v.c_z,
-                v.k_z,
-                Some(r.rcond_x),
-                Some(r.rcond_z),
-                // (exact: a window index is far below 2^53)
-                r.window.map(|w| w as f64),
-            ],
-        )
+        debug_assert_eq!(r.model, self.model, "one model per estimates file");
+        let n = self.model.per_direction().len();
+        self.fields.clear();
+        self.fields.push(Some(r.t));
+        self.fields.extend_from_slice(&r.values[..n]);
+        self.fields.extend([
+            Some(r.rcond_x),
+            Some(r.rcond_z),
+            // (exact: a window index is far below 2^53)
+            r.window.map(|w| w as f64),
+        ]);
+        write_row(&mut self.out, &mut self.scratch, &self.fields)
     }
 
     /// Flush the underlying writer.
@@ -140,6 +199,8 @@ pub struct EstimatesReader<R: Read> {
     file: String,
     csv: CsvReader<R>,
     header: Header,
+    model: ModelKind,
+    names: Vec<&'static str>,
     cols: Vec<usize>,
     window: Option<usize>,
 }
@@ -158,15 +219,30 @@ impl<R: Read> EstimatesReader<R> {
             ));
         };
         let header = Header::new(&rec, rec.line());
-        let cols = header.require(file, &ESTIMATES_REQUIRED)?;
+        // a cross-coupled model's file names its coefficients cxx .. kzz
+        let model = if header.find(file, "cxx")?.is_some() {
+            ModelKind::CrossCoupled
+        } else {
+            ModelKind::Jeffcott
+        };
+        let mut names = estimates_header(model);
+        names.pop(); // window: optional
+        let cols = header.require(file, &names)?;
         let window = header.find(file, "window")?;
         Ok(Self {
             file: file.to_owned(),
             csv,
             header,
+            model,
+            names,
             cols,
             window,
         })
+    }
+
+    /// The model of the file's columns.
+    pub fn model(&self) -> ModelKind {
+        self.model
     }
 
     /// The next row, or `None` at the end.
@@ -179,7 +255,8 @@ impl<R: Read> EstimatesReader<R> {
         let rec = &rec;
         check_length(f, rec, line, &self.header)?;
         let c = &self.cols;
-        let opt = |i: usize| optional_field(f, rec, line, c[i], ESTIMATES_HEADER[i]);
+        let names = &self.names;
+        let opt = |i: usize| optional_field(f, rec, line, c[i], names[i]);
         let window = match self.window {
             None => None,
             Some(col) => match optional_field(f, rec, line, col, "window")? {
@@ -199,20 +276,21 @@ impl<R: Read> EstimatesReader<R> {
                 }
             },
         };
-        Ok(Some(EstimateRow {
-            t: finite_field(f, rec, line, c[0], "t")?,
-            values: ParameterSet {
-                m_x: opt(1)?,
-                c_x: opt(2)?,
-                k_x: opt(3)?,
-                m_z: opt(4)?,
-                c_z: opt(5)?,
-                k_z: opt(6)?,
-            },
-            rcond_x: number_field(f, rec, line, c[7], "rcond_x")?,
-            rcond_z: number_field(f, rec, line, c[8], "rcond_z")?,
+        let n = self.model.per_direction().len();
+        let mut values = [None; 10];
+        for (i, v) in values.iter_mut().take(n).enumerate() {
+            *v = opt(1 + i)?;
+        }
+        Ok(Some(EstimateRow::new(
+            finite_field(f, rec, line, c[0], "t")?,
+            self.model,
+            &values,
+            [
+                number_field(f, rec, line, c[n + 1], "rcond_x")?,
+                number_field(f, rec, line, c[n + 2], "rcond_z")?,
+            ],
             window,
-        }))
+        )))
     }
 }
 
@@ -222,35 +300,19 @@ mod tests {
 
     #[test]
     fn rows_round_trip_with_missing_directions() {
+        let j = ModelKind::Jeffcott;
         let rows = [
-            EstimateRow {
-                t: 0.0,
-                values: ParameterSet::default(),
-                rcond_x: 0.0,
-                rcond_z: 0.0,
-                window: Some(0),
-            },
-            EstimateRow {
-                t: 1e-4,
-                values: ParameterSet {
-                    m_x: Some(14.29),
-                    c_x: Some(10.000_000_1),
-                    k_x: Some(1.195e6),
-                    ..Default::default()
-                },
-                rcond_x: 1.5e-3,
-                rcond_z: 2e-9,
-                window: Some(12),
-            },
-            EstimateRow {
-                t: 2e-4,
-                values: ParameterSet::default(),
-                rcond_x: 1.0,
-                rcond_z: 1.0,
-                window: None,
-            },
+            EstimateRow::new(0.0, j, &[], [0.0, 0.0], Some(0)),
+            EstimateRow::new(
+                1e-4,
+                j,
+                &[Some(14.29), Some(10.000_000_1), Some(1.195e6)],
+                [1.5e-3, 2e-9],
+                Some(12),
+            ),
+            EstimateRow::new(2e-4, j, &[], [1.0, 1.0], None),
         ];
-        let mut w = EstimatesWriter::new(Vec::new()).unwrap();
+        let mut w = EstimatesWriter::for_model(Vec::new(), j).unwrap();
         for r in &rows {
             w.write(r).unwrap();
         }
@@ -272,9 +334,9 @@ mod tests {
         let h = ESTIMATES_HEADER.join(",");
         let text = format!("{h}\n0,NaN,1,2,3,4,5,0.1,0.2,0\n");
         let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
-        let row = r.next_row().unwrap().unwrap();
-        assert_eq!(row.values.m_x, None);
-        assert_eq!(row.values.k_z, Some(5.0));
+        let row = r.next_row().unwrap().unwrap().jeffcott().unwrap();
+        assert_eq!(row.m_x, None);
+        assert_eq!(row.k_z, Some(5.0));
         let text = format!("{h}\n0,1,x,2,3,4,5,0.1,0.2,0\n");
         let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
         assert!(r
@@ -299,5 +361,34 @@ mod tests {
         assert!(e
             .to_string()
             .starts_with("e.csv line 1: the header lacks columns c_x, k_x"));
+    }
+
+    #[test]
+    fn cross_coupled_rows_round_trip_under_their_own_header() {
+        let c = ModelKind::CrossCoupled;
+        let values: Vec<Option<f64>> = (0..10)
+            .map(|i| (i != 7).then(|| (i as f64 - 4.5) * 1.25))
+            .collect();
+        let rows = [
+            EstimateRow::new(0.5, c, &values, [1e-3, 2e-4], Some(3)),
+            EstimateRow::new(0.6, c, &[], [0.0, 0.0], None),
+        ];
+        let mut w = EstimatesWriter::for_model(Vec::new(), c).unwrap();
+        for r in &rows {
+            w.write(r).unwrap();
+        }
+        let text = String::from_utf8(w.into_inner()).unwrap();
+        assert_eq!(
+            text,
+            "t,m_x,cxx,cxz,kxx,kxz,m_z,czx,czz,kzx,kzz,rcond_x,rcond_z,window\n\
+             0.5,-5.625,-4.375,-3.125,-1.875,-0.625,0.625,1.875,,4.375,5.625,0.001,0.0002,3\n\
+             0.6,,,,,,,,,,,0,0,\n"
+        );
+        let mut r = EstimatesReader::new("e.csv", text.as_bytes()).unwrap();
+        assert_eq!(r.model(), c);
+        for row in &rows {
+            assert_eq!(r.next_row().unwrap().as_ref(), Some(row));
+        }
+        assert_eq!(rows[0].jeffcott(), None);
     }
 }

@@ -34,7 +34,6 @@ pub use estimates_csv::{
 pub use output::{
     check_distinct_files, is_broken_pipe, open_input, stdout_error, FileMode, Output, StdoutClosed,
 };
-pub use params::ParameterSet;
 pub use response_csv::{ResponseReader, ResponseWriter};
 pub use rotorid_io::csv::CsvError;
 pub use scenario::{LoadScenario, ScenarioSpec, SimulationOverrides, Truth};

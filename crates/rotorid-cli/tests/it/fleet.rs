@@ -35,6 +35,44 @@ fn estimates(status: &str) -> Vec<(String, f64, f64)> {
         .collect()
 }
 
+/// The fleet status once `machine` has `windows` windows identified.
+fn wait_for_windows(url: &str, machine: &str, windows: usize) -> String {
+    let t = Instant::now();
+    let n = windows.to_string();
+    loop {
+        let s = run(&["fleet", "status", "--nats", url]);
+        let done = s.lines().any(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            f.first() == Some(&machine) && f.get(2) == Some(&n.as_str())
+        });
+        if done {
+            return s;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(300), // against a hang, not a speed test
+            "not identified:\n{s}"
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
+/// SIGTERM: the worker finishes its window and exits 0.
+fn stop(worker: std::process::Child) {
+    let pid = worker.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let out = worker.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "worker: {:?}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 #[test]
 fn a_recording_published_in_windows_is_identified_by_a_worker() {
     let dir = tempfile::tempdir().unwrap();
@@ -83,36 +121,8 @@ fn a_recording_published_in_windows_is_identified_by_a_worker() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let t = Instant::now();
-    let status = loop {
-        let s = run(&["fleet", "status", "--nats", &url]);
-        let done = s.lines().any(|l| {
-            let f: Vec<&str> = l.split_whitespace().collect();
-            f.first() == Some(&"rig-1") && f.get(2) == Some(&"3")
-        });
-        if done {
-            break s;
-        }
-        assert!(
-            t.elapsed() < Duration::from_secs(300), // against a hang, not a speed test
-            "not identified:\n{s}"
-        );
-        std::thread::sleep(Duration::from_millis(200));
-    };
-    // SIGTERM: the worker finishes its window and exits 0
-    let pid = worker.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .unwrap()
-        .success());
-    let out = worker.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "worker: {:?}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let status = wait_for_windows(&url, "rig-1", 3);
+    stop(worker);
     assert!(status.contains("window 2"), "{status}");
     // the latest window (2 s to 3 s) as offline identify gives it on the same samples
     let text = std::fs::read_to_string(rec).unwrap();
@@ -165,6 +175,113 @@ fn a_recording_published_in_windows_is_identified_by_a_worker() {
         assert!(
             (v - truth).abs() < 5.0 * e,
             "{name}: {v} +- {e}, truth {truth}"
+        );
+    }
+}
+
+#[test]
+fn a_worker_identifies_the_cross_coupled_model_it_is_given() {
+    // `--model cross_coupled` reaches the worker: each window's ten values of the
+    // cross-coupled modulating identifier, as offline `identify` gives them
+    let dir = tempfile::tempdir().unwrap();
+    let server = Server::start(&dir.path().join("js"));
+    let url = server.url();
+    let scenario = dir.path().join("cross.toml");
+    std::fs::write(
+        &scenario,
+        "[rotor]\nmodel = \"cross_coupled\"\nm = 14.29\na = 2.871\nkxx = 1.195e6\n\
+         kxz = -3.0e4\nkzx = 3.0e4\nkzz = 1.4e6\ncxx = 200.0\ncxz = 20.0\nczx = 20.0\n\
+         czz = 200.0\nm_u = 1e-4\nd = 0.15\nalpha_deg = 45.0\n\n[speed]\nkind = \
+         \"constant\"\nrpm = 1200.0\n\n[sampling]\ndt = 1e-4\nduration = 1.0\n",
+    )
+    .unwrap();
+    // the workers know only what identify needs: a, the unbalance, the speed
+    let known = dir.path().join("known.toml");
+    std::fs::write(
+        &known,
+        "[rotor]\na = 2.871\nm_u = 1e-4\nd = 0.15\nalpha_deg = 45.0\n\n[speed]\n\
+         kind = \"constant\"\nrpm = 1200.0\n",
+    )
+    .unwrap();
+    let (scenario, known) = (scenario.to_str().unwrap(), known.to_str().unwrap());
+    let rec = dir.path().join("r.csv");
+    let rec = rec.to_str().unwrap();
+    run(&[
+        "simulate",
+        "--scenario",
+        scenario,
+        "--snr-db",
+        "40",
+        "--seed",
+        "3",
+        "--out",
+        rec,
+        "-q",
+    ]);
+    run(&[
+        "publish",
+        rec,
+        "--nats",
+        &url,
+        "--machine",
+        "rig-2",
+        "--window-s",
+        "1",
+    ]);
+    let settings = ["--method", "modulating", "--model", "cross_coupled"];
+    let worker = Command::new(assert_cmd::cargo::cargo_bin("rotorid"))
+        .args(["worker", "--nats", &url, "--scenario", known])
+        .args(settings)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let status = wait_for_windows(&url, "rig-2", 1);
+    stop(worker);
+    let sum = dir.path().join("s.json");
+    run(&[
+        "identify",
+        rec,
+        "--scenario",
+        known,
+        "--out",
+        dir.path().join("e.csv").to_str().unwrap(),
+        "--summary",
+        sum.to_str().unwrap(),
+        "-q",
+    ]
+    .iter()
+    .copied()
+    .chain(settings)
+    .collect::<Vec<_>>());
+    let offline: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&sum).unwrap()).unwrap();
+    assert_eq!(offline["model"], "cross_coupled");
+    let got = estimates(&status);
+    let names: Vec<&str> = got.iter().map(|(n, _, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        ["m_x", "cxx", "cxz", "kxx", "kxz", "m_z", "czx", "czz", "kzx", "kzz"],
+        "{status}"
+    );
+    for (name, v, e) in got {
+        let p = offline["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["parameter"] == name.as_str())
+            .unwrap();
+        let (ov, oe) = (
+            p["value"].as_f64().unwrap(),
+            p["std_error"].as_f64().unwrap(),
+        );
+        assert!(
+            (v - ov).abs() <= 1e-6 * ov.abs(),
+            "{name}: {v} vs offline {ov}"
+        );
+        assert!(
+            (e - oe).abs() <= 1e-2 * oe,
+            "{name}: +- {e} vs offline {oe}"
         );
     }
 }

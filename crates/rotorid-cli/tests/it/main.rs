@@ -5,6 +5,7 @@ mod common;
 mod analysis;
 mod balance;
 mod balance_published;
+mod cross;
 mod daqmx;
 mod dashboard;
 mod dashboard_browser;

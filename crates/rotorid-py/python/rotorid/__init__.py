@@ -43,12 +43,20 @@ import numpy as np
 import pandas as pd
 
 from . import _rotorid
-from ._rotorid import ESTIMATE_COLUMNS, METHODS, MODELS, UNKNOWNS, Scenario
+from ._rotorid import (
+    ESTIMATE_COLUMNS,
+    ESTIMATE_COLUMNS_BY_MODEL,
+    METHODS,
+    MODELS,
+    UNKNOWNS,
+    Scenario,
+)
 from ._balance import Balance, TrialPlan, balance, plan_trials
 from ._result import Identification
 
 __all__ = [
     "ESTIMATE_COLUMNS",
+    "ESTIMATE_COLUMNS_BY_MODEL",
     "METHODS",
     "MODELS",
     "UNKNOWNS",
@@ -377,6 +385,7 @@ class Session:
         """The identification of every sample pushed; its ``estimates`` hold every row."""
         summary, rest = self._inner.finish(input=input, scenario_name=scenario)
         chunks = [*self._chunks, rest]
-        estimates = {k: np.concatenate([c[k] for c in chunks]) for k in ESTIMATE_COLUMNS}
+        # (every chunk has its model's columns, the last one included)
+        estimates = {k: np.concatenate([c[k] for c in chunks]) for k in rest}
         self._chunks = []
         return Identification(summary, estimates)

@@ -14,6 +14,7 @@ from ._result import Identification as Identification
 
 __all__ = [
     "ESTIMATE_COLUMNS",
+    "ESTIMATE_COLUMNS_BY_MODEL",
     "METHODS",
     "MODELS",
     "UNKNOWNS",
@@ -35,6 +36,7 @@ METHODS: list[str]
 MODELS: list[str]
 UNKNOWNS: list[str]
 ESTIMATE_COLUMNS: list[str]
+ESTIMATE_COLUMNS_BY_MODEL: dict[str, list[str]]
 
 @final
 class Scenario:

@@ -165,10 +165,11 @@ class Identification:
     def estimates(self) -> pd.DataFrame:
         if self._estimates is None:
             cols = self._estimate_columns or {}
-            from . import ESTIMATE_COLUMNS
+            from . import ESTIMATE_COLUMNS_BY_MODEL
 
+            names = ESTIMATE_COLUMNS_BY_MODEL[self._summary.get("model", "jeffcott")]
             self._estimates = pd.DataFrame(
-                {k: cols.get(k, np.empty(0)) for k in ESTIMATE_COLUMNS}, copy=False
+                {k: cols.get(k, np.empty(0)) for k in names}, copy=False
             )
         return self._estimates
 
@@ -300,11 +301,13 @@ class Identification:
         e = self.estimates
         truth = self.params["truth"]
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 6))
-        for ax, q, unit, ref in zip(
-            axes, "mck", ("kg", "N s/m", "N/m"), (("m_x", "m_z"), ("cx", "cz"), ("kx", "kz"))
-        ):
-            for d, name in zip("xz", ref):
-                ax.plot(e["t"], e[f"{q}_{d}"], label=f"{q}_{d}", lw=1)
+        # the value columns between t and rcond_x: m_x, c_x, ... or m_x, cxx, cxz, ...
+        values = [c for c in e.columns if c not in ("t", "rcond_x", "rcond_z", "window")]
+        for ax, q, unit in zip(axes, "mck", ("kg", "N s/m", "N/m")):
+            for column in (c for c in values if c.startswith(q)):
+                # the parameter's name: m_x stays, c_x is cx, cxz is cxz
+                name = column if q == "m" else column.replace("_", "")
+                ax.plot(e["t"], e[column], label=column, lw=1)
                 if name in truth.index and not math.isnan(truth[name]):
                     ax.axhline(truth[name], ls="--", lw=0.8, color="k")
             ax.set_ylabel(f"{q} [{unit}]")

@@ -6,12 +6,13 @@ import numpy as np
 
 from . import Scenario as Scenario
 
-__all__ = ["ESTIMATE_COLUMNS", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "read", "read_blocks", "simulate"]
+__all__ = ["ESTIMATE_COLUMNS", "ESTIMATE_COLUMNS_BY_MODEL", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "read", "read_blocks", "simulate"]
 
 METHODS: list[str]
 MODELS: list[str]
 UNKNOWNS: list[str]
 ESTIMATE_COLUMNS: list[str]
+ESTIMATE_COLUMNS_BY_MODEL: dict[str, list[str]]
 
 def simulate(
     scenario: Scenario,

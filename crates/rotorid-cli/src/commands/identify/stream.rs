@@ -25,9 +25,7 @@ use rotorid::pipeline::{
 use rotorid::SpeedProfile;
 
 use crate::io::estimates_csv::estimates_parquet;
-use crate::io::{
-    CsvError, EstimateRow, EstimatesWriter, Output, ParameterSet, ResponseReader, ScenarioSpec,
-};
+use crate::io::{CsvError, EstimateRow, EstimatesWriter, Output, ResponseReader, ScenarioSpec};
 
 /// Rows a reader thread parses before it hands them over.
 const BATCH_ROWS: usize = 4096;
@@ -90,7 +88,11 @@ impl Rows {
             return;
         }
         if self.writer.is_none() {
-            match self.out.take().map(EstimatesWriter::new) {
+            match self
+                .out
+                .take()
+                .map(|o| EstimatesWriter::for_model(o, e.model))
+            {
                 Some(Ok(w)) => self.writer = Some(w),
                 Some(Err(err)) => self.error = Some(err),
                 None => {}
@@ -233,20 +235,16 @@ pub(crate) fn identify(
             return Err(e);
         }
     };
-    let last = ident.final_estimate().map(|f| EstimateRow {
-        t: f.t_s,
-        values: ParameterSet::from_array(f.values),
-        rcond_x: f.rcond.x,
-        rcond_z: f.rcond.z,
-        window: None,
-    });
+    let last = ident
+        .final_estimate()
+        .map(|f| EstimateRow::new(f.t_s, f.model, &f.values, [f.rcond.x, f.rcond.z], None));
     if let Some(mut table) = parquet {
         table.extend(last);
-        let bytes = estimates_parquet(io.out_name, &table)?;
+        let bytes = estimates_parquet(io.out_name, ident.model, &table)?;
         out.write_all(&bytes)
             .with_context(|| format!("cannot write {}", io.out_name))?;
     } else if let Some(last) = last {
-        let mut w = EstimatesWriter::new(&mut out)
+        let mut w = EstimatesWriter::for_model(&mut out, last.model)
             .with_context(|| format!("cannot write {}", io.out_name))?;
         w.write(&last)
             .with_context(|| format!("cannot write {}", io.out_name))?;
@@ -489,23 +487,13 @@ fn finish_error(e: PipelineError, scenario: &str) -> String {
     }
 }
 
-/// The estimates CSV row of one algebraic estimate: m, c, k only where well conditioned.
+/// The estimates CSV row of one algebraic estimate: the values only where their
+/// direction is well conditioned.
 fn row_of(e: &SampleEstimate) -> EstimateRow {
-    let est = &e.estimate;
-    let ok = e.well_conditioned;
-    let keep = |v: f64, ok: bool| (ok && v.is_finite()).then_some(v);
-    EstimateRow {
-        t: est.t,
-        values: ParameterSet {
-            m_x: keep(est.x.m, ok[0]),
-            c_x: keep(est.x.c, ok[0]),
-            k_x: keep(est.x.k, ok[0]),
-            m_z: keep(est.z.m, ok[1]),
-            c_z: keep(est.z.c, ok[1]),
-            k_z: keep(est.z.k, ok[1]),
-        },
-        rcond_x: est.x.rcond,
-        rcond_z: est.z.rcond,
-        window: Some(e.window),
+    let n = e.values().len();
+    let mut values = [None; 10];
+    for (i, v) in values.iter_mut().take(n).enumerate() {
+        *v = e.usable(i);
     }
+    EstimateRow::new(e.t, e.model, &values, e.rcond, Some(e.window))
 }
