@@ -367,7 +367,7 @@ mod tests {
     fn cross_coupled_rows_round_trip_under_their_own_header() {
         let c = ModelKind::CrossCoupled;
         let values: Vec<Option<f64>> = (0..10)
-            .map(|i| (i != 7).then(|| (i as f64 - 4.5) * 1.25))
+            .map(|i| (i != 7).then_some((i as f64 - 4.5) * 1.25))
             .collect();
         let rows = [
             EstimateRow::new(0.5, c, &values, [1e-3, 2e-4], Some(3)),

@@ -236,7 +236,7 @@ enum Engine {
         id: AlgebraicEngine,
         settings: AlgebraicSettings,
         flagged: Directions<u64>,
-        last: Option<SampleEstimate>,
+        last: Option<Box<SampleEstimate>>,
         keep: Option<Vec<SampleEstimate>>,
         /// The first [`ALGEBRAIC_ADEQUACY_SAMPLES`] samples, for the adequacy test.
         kept: Kept,
@@ -632,7 +632,10 @@ impl Session {
                 let ok = e.well_conditioned;
                 flagged.x += u64::from(!ok[0]);
                 flagged.z += u64::from(!ok[1]);
-                *last = Some(e);
+                match last {
+                    Some(l) => **l = e,
+                    None => *last = Some(Box::new(e)),
+                }
                 if let Some(k) = keep {
                     k.push(e);
                 }
@@ -701,7 +704,7 @@ impl Session {
                     id.model(),
                     &id.results(),
                     flagged,
-                    last,
+                    last.map(|l| *l),
                     id.windows(),
                 );
                 ident.estimates = keep.unwrap_or_default();

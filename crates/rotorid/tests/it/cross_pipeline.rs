@@ -24,9 +24,10 @@ fn algebraic() -> Method {
 }
 
 fn modulating() -> Method {
-    let mut s = ModulatingSettings::default();
-    s.model = Some(ModelKind::CrossCoupled);
-    Method::Modulating(s)
+    Method::Modulating(ModulatingSettings {
+        model: Some(ModelKind::CrossCoupled),
+        ..ModulatingSettings::default()
+    })
 }
 
 /// The cross-coupled test rotor at 1200 rpm from rest, `duration` s at 10 kHz, clean.

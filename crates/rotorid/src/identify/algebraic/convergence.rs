@@ -375,9 +375,9 @@ pub struct ConvergenceTracker<const N: usize = 6> {
 }
 
 impl ConvergenceTracker<6> {
-    /// A tracker of the Jeffcott identifier's six values with relative band `tol` (finite,
-    /// >= 0) that ignores instants with rcond < `rcond_min` (in [0, 1]), with the default
-    /// stack capacity.
+    /// A tracker of the Jeffcott identifier's six values with relative band `tol` (finite
+    /// and non-negative) that ignores instants with rcond < `rcond_min` (in [0, 1]), with
+    /// the default stack capacity.
     pub fn new(tol: f64, rcond_min: f64) -> Result<Self, AlgebraicError> {
         Self::with_capacity(tol, rcond_min, DEFAULT_STACK_CAPACITY)
     }
