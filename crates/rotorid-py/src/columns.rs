@@ -181,8 +181,12 @@ impl Estimates {
         self.push(&row);
     }
 
-    /// The one row of a batch method (modulating, refine).
+    /// The one row of a batch method (modulating, refine); an empty table takes the row's
+    /// model (refine's `auto` chooses it at the end).
     pub fn push_final(&mut self, f: &FinalEstimate) {
+        if self.is_empty() {
+            *self = Self::new(f.model);
+        }
         let mut row = Vec::with_capacity(f.values.len() + 4);
         row.push(f.t_s);
         row.extend(f.values.iter().map(|v| v.unwrap_or(f64::NAN)));
@@ -190,8 +194,14 @@ impl Estimates {
         self.push(&row);
     }
 
-    /// The rows of `other` (of the same model) after these.
+    /// The rows of `other` after these (an empty table takes `other`'s model: a batch
+    /// method's one row may be of the model it chose).
     pub fn append(&mut self, other: Estimates) {
+        if self.is_empty() {
+            *self = other;
+            return;
+        }
+        debug_assert_eq!(self.model, other.model, "rows of one model");
         for (c, o) in self.columns.iter_mut().zip(other.columns) {
             if c.is_empty() {
                 *c = o;

@@ -385,7 +385,12 @@ class Session:
         """The identification of every sample pushed; its ``estimates`` hold every row."""
         summary, rest = self._inner.finish(input=input, scenario_name=scenario)
         chunks = [*self._chunks, rest]
-        # (every chunk has its model's columns, the last one included)
-        estimates = {k: np.concatenate([c[k] for c in chunks]) for k in rest}
+        # the chunks with rows are of one model (an algebraic stream's); a batch method's
+        # one row may be of the model refine chose, its earlier chunks empty
+        full = [c for c in chunks if len(c["t"])]
+        names = list(full[0]) if full else list(rest)
+        estimates = {
+            k: np.concatenate([c[k] for c in full]) if full else rest[k] for k in names
+        }
         self._chunks = []
         return Identification(summary, estimates)

@@ -341,7 +341,7 @@ impl Session {
         let model = match method {
             Method::Algebraic(s) => s.model,
             Method::Modulating(s) => s.model,
-            Method::Refine(_) => None,
+            Method::Refine(s) => s.model.and_then(super::ModelChoice::fixed),
         }
         .unwrap_or(knowledge.model);
         let grid = match timing {
@@ -381,8 +381,8 @@ impl Session {
         self.keep = true;
     }
 
-    /// The model identified: the method's `model`, else the knowledge's (refine may end
-    /// in another when it chooses, see [`Identification::model`]).
+    /// The model identified: the method's `model`, else the knowledge's (refine with
+    /// `model: auto` chooses at the end, see [`Identification::model`]).
     pub fn model(&self) -> ModelKind {
         self.model
     }
