@@ -147,7 +147,6 @@ impl EstimateRow {
 pub struct EstimatesWriter<W: Write> {
     out: W,
     scratch: Vec<u8>,
-    fields: Vec<Option<f64>>,
     model: ModelKind,
 }
 
@@ -159,25 +158,23 @@ impl<W: Write> EstimatesWriter<W> {
         Ok(Self {
             out,
             scratch: Vec::with_capacity(256),
-            fields: Vec::with_capacity(header.len()),
             model,
         })
     }
 
     /// Write one row (of the writer's model).
+    #[inline]
     pub fn write(&mut self, r: &EstimateRow) -> io::Result<()> {
         debug_assert_eq!(r.model, self.model, "one model per estimates file");
         let n = self.model.per_direction().len();
-        self.fields.clear();
-        self.fields.push(Some(r.t));
-        self.fields.extend_from_slice(&r.values[..n]);
-        self.fields.extend([
-            Some(r.rcond_x),
-            Some(r.rcond_z),
-            // (exact: a window index is far below 2^53)
-            r.window.map(|w| w as f64),
-        ]);
-        write_row(&mut self.out, &mut self.scratch, &self.fields)
+        let mut fields = [None; 14];
+        fields[0] = Some(r.t);
+        fields[1..=n].copy_from_slice(&r.values[..n]);
+        fields[n + 1] = Some(r.rcond_x);
+        fields[n + 2] = Some(r.rcond_z);
+        // (exact: a window index is far below 2^53)
+        fields[n + 3] = r.window.map(|w| w as f64);
+        write_row(&mut self.out, &mut self.scratch, &fields[..n + 4])
     }
 
     /// Flush the underlying writer.

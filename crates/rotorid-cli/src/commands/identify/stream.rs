@@ -489,11 +489,20 @@ fn finish_error(e: PipelineError, scenario: &str) -> String {
 
 /// The estimates CSV row of one algebraic estimate: the values only where their
 /// direction is well conditioned.
+#[inline]
 fn row_of(e: &SampleEstimate) -> EstimateRow {
-    let n = e.values().len();
+    let v = e.values();
+    let half = v.len() / 2;
     let mut values = [None; 10];
-    for (i, v) in values.iter_mut().take(n).enumerate() {
-        *v = e.usable(i);
+    for (i, (out, &x)) in values.iter_mut().zip(v).enumerate() {
+        *out = (e.well_conditioned[i / half] && x.is_finite()).then_some(x);
     }
-    EstimateRow::new(e.t, e.model, &values, e.rcond, Some(e.window))
+    EstimateRow {
+        t: e.t,
+        model: e.model,
+        values,
+        rcond_x: e.rcond[0],
+        rcond_z: e.rcond[1],
+        window: Some(e.window),
+    }
 }
