@@ -6,7 +6,7 @@ import numpy as np
 
 from . import Scenario as Scenario
 
-__all__ = ["ESTIMATE_COLUMNS", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "read", "read_blocks", "simulate"]
+__all__ = ["ESTIMATE_COLUMNS", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "load_finite_element", "read", "read_blocks", "read_fe_matrices", "simulate"]
 
 METHODS: list[str]
 MODELS: list[str]
