@@ -398,6 +398,9 @@ mod tests {
         }
     }
 
+    /// An archive's members: (name without `.npy`, bytes).
+    type Members = Vec<(String, Vec<u8>)>;
+
     /// A member `name` of an archive, as `npy` bytes with a hand-written header.
     fn archive(members: &[(&str, Vec<u8>)]) -> Vec<u8> {
         let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
@@ -453,7 +456,7 @@ mod tests {
         let f = sample(false, false);
         let good = npz_bytes("rotor.npz", &f).unwrap();
         let zip = zip::ZipArchive::new(std::io::Cursor::new(good.clone())).unwrap();
-        let mut members: Vec<(String, Vec<u8>)> = Vec::new();
+        let mut members: Members = Vec::new();
         let mut z = zip;
         for i in 0..z.len() {
             let mut m = z.by_index(i).unwrap();
@@ -461,7 +464,7 @@ mod tests {
             std::io::Read::read_to_end(&mut m, &mut b).unwrap();
             members.push((m.name().trim_end_matches(".npy").to_owned(), b));
         }
-        let with = |edit: &dyn Fn(&mut Vec<(String, Vec<u8>)>)| {
+        let with = |edit: &dyn Fn(&mut Members)| {
             let mut m = members.clone();
             edit(&mut m);
             let refs: Vec<(&str, Vec<u8>)> =

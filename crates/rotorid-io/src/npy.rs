@@ -193,8 +193,11 @@ pub(crate) fn parse_array(c: &mut Cursor, name: &str) -> Result<Array, ReadError
     }
     let kind = match (endian, t) {
         (Some(_), "f8") => Some(Kind::F64),
-        (Some(_), u) if u.starts_with('U') => width(&u[1..]).map(Kind::Utf32),
-        (Some(_), b) if b.starts_with('S') => width(&b[1..]).map(Kind::Bytes),
+        (Some(_), t) => match (t.strip_prefix('U'), t.strip_prefix('S')) {
+            (Some(w), _) => width(w).map(Kind::Utf32),
+            (_, Some(w)) => width(w).map(Kind::Bytes),
+            _ => None,
+        },
         _ => None,
     };
     let (Some(kind), Some(endian)) = (kind, endian) else {

@@ -3,6 +3,9 @@
 //! `dofs` as unicode and as bytes) read entry for entry, numpy's faults named, and the
 //! writer's members byte for byte what numpy.savez wrote for the same arrays.
 
+// (ReadError is large by design: it carries the file, member and values inline)
+#![allow(clippy::result_large_err)]
+
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
 

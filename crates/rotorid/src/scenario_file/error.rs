@@ -63,7 +63,7 @@ pub enum ScenarioFileError {
     #[error(
         "{}: unknown key {section}.{key}; allowed keys in [{section}]: {allowed}{}",
         At(origin, line),
-        other_model.map_or(String::new(), |m| format!(" ({key} is a key of rotor.model = \"{m}\")"))
+        other_model.map_or(String::new(), |m| format!(" ({key} is a key of rotor.model = \"{}\")", m.name()))
     )]
     UnknownKey {
         /// The file name.
@@ -76,9 +76,9 @@ pub enum ScenarioFileError {
         key: String,
         /// The section's keys, comma-separated.
         allowed: String,
-        /// The model whose key it is (its `rotor.model` name), when it is another model's
-        /// rotor key (the message then says `kxx is a key of rotor.model = "cross_coupled"`).
-        other_model: Option<&'static str>,
+        /// The model whose key it is, when it is another model's rotor key (the message
+        /// then says `kxx is a key of rotor.model = "cross_coupled"`).
+        other_model: Option<RotorModel>,
     },
     /// A value of the wrong TOML type (`rotor.m = "heavy"`).
     #[error(
@@ -286,6 +286,25 @@ pub enum ScenarioFileError {
         /// The command-line flag that may give it instead (`--dt`).
         flag: String,
     },
+}
+
+/// A value of `rotor.model`: a lumped model or the finite-element rotor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RotorModel {
+    /// `jeffcott` or `cross_coupled`.
+    Lumped(crate::parameter::ModelKind),
+    /// `finite_element`.
+    FiniteElement,
+}
+
+impl RotorModel {
+    /// Its name in `rotor.model`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Lumped(m) => m.name(),
+            Self::FiniteElement => super::FINITE_ELEMENT,
+        }
+    }
 }
 
 impl ScenarioFileError {

@@ -33,6 +33,7 @@ use std::sync::Arc;
 use toml_edit::{Item, Value};
 
 use super::acquisition::{Entries, Node, Val};
+use super::error::RotorModel;
 use super::parse::Parser;
 use super::{rotor_keys, ScenarioFileError};
 use crate::model::finite_element::{
@@ -170,7 +171,7 @@ impl Parser<'_> {
                 let other_model = ModelKind::ALL
                     .into_iter()
                     .find(|m| rotor_keys(*m).iter().any(|(kk, _)| *kk == k))
-                    .map(ModelKind::name);
+                    .map(RotorModel::Lumped);
                 return Err(ScenarioFileError::UnknownKey {
                     origin: self.origin.to_owned(),
                     line: self.key_line(key),

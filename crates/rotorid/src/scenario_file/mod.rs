@@ -81,7 +81,7 @@ mod parse;
 use std::collections::BTreeMap;
 use std::fmt;
 
-pub use error::ScenarioFileError;
+pub use error::{RotorModel, ScenarioFileError};
 pub use finite_element::{FiniteElementSpec, FINITE_ELEMENT};
 
 use crate::model::{CrossCoupling, ModelError};

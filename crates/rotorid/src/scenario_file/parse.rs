@@ -13,6 +13,7 @@ use std::ops::Range;
 
 use toml_edit::{ImDocument, Item, Key, Value};
 
+use super::error::RotorModel;
 use super::finite_element::{FINITE_ELEMENT, FINITE_ELEMENT_KEYS};
 use super::{
     rotor_error, rotor_keys, unit_of, Num, RotorArray, ScenarioFileError, ScenarioSpec, Section,
@@ -287,8 +288,10 @@ impl Parser<'_> {
                                 rotor_keys(*m) != keys
                                     && rotor_keys(*m).iter().any(|(k, _)| *k == key)
                             })
-                            .map(ModelKind::name)
-                            .or(FINITE_ELEMENT_KEYS.contains(&key).then_some(FINITE_ELEMENT))
+                            .map(RotorModel::Lumped)
+                            .or(FINITE_ELEMENT_KEYS
+                                .contains(&key)
+                                .then_some(RotorModel::FiniteElement))
                     })
                     .flatten();
                 return Err(ScenarioFileError::UnknownKey {
