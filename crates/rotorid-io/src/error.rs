@@ -117,6 +117,20 @@ pub enum ReadError {
         /// What was there instead.
         why: String,
     },
+    /// A member of an archive with a fixed set of members (the finite-element matrices
+    /// file, [`crate::fe_matrices`]) that is missing, repeated, unknown, or of a shape or
+    /// dtype the file's contract does not allow.
+    #[error("{file}: member {member} {found}: {allowed}")]
+    Member {
+        /// The file.
+        file: String,
+        /// The member (`K`, `dofs`).
+        member: String,
+        /// What the file holds (`is 38 x 40`, `is missing`, `has dtype '<f4'`).
+        found: String,
+        /// What is allowed (`must be 40 x 40 (one row and column per entry of dofs)`).
+        allowed: String,
+    },
     /// A library reading the container (HDF5 for MAT v7.3, Parquet, zip for NPZ) failed.
     #[error("{file}{}: {container}: {message}", Ch(channel))]
     Container {
@@ -162,6 +176,7 @@ impl ReadError {
             | ReadError::NotUtf8 { file, .. }
             | ReadError::InexactInteger { file, .. }
             | ReadError::NoChannels { file, .. }
+            | ReadError::Member { file, .. }
             | ReadError::Container { file, .. } => file,
             ReadError::Csv(e) => &e.file,
         }

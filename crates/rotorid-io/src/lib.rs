@@ -28,6 +28,10 @@
 //!
 //! [`write_table`] writes a table back as NPZ, MAT level 5 or Parquet ([`mod@write`]).
 //!
+//! [`fe_matrices`] reads and writes the matrices file of a finite-element rotor (an NPZ of
+//! `M`, `K`, `G`, optional `C`, `Ka`, and `dofs`), not a table: its members are checked
+//! against that contract by name, shape and dtype.
+//!
 //! Samples are passed through as stored: NaN and infinities are data here, and the
 //! identification pipeline checks finiteness. Integers convert to `f64` exactly or not at
 //! all ([`ReadError::InexactInteger`]).
@@ -47,6 +51,7 @@
 pub mod csv;
 mod cursor;
 pub mod error;
+pub mod fe_matrices;
 pub mod format;
 mod guard;
 pub mod mat;
@@ -64,6 +69,7 @@ pub mod units;
 pub mod write;
 
 pub use error::ReadError;
+pub use fe_matrices::FeMatricesFile;
 pub use format::{read_bytes, read_table, Format};
 pub use select::{select, ColumnMap, SelectError, SiColumns};
 pub use stream::{open_blocks, RowBlocks, SiBlock, SiBlocks};

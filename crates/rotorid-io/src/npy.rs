@@ -52,27 +52,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 /// array's columns are `0`, `1`, ... or, with `prefixed`, `name.0`, `name.1`, ...
 pub(crate) fn parse(c: &mut Cursor, name: &str, prefixed: bool) -> Result<Vec<Channel>, ReadError> {
     c.channel = Some(name.to_string());
-    let magic = c.take(6, "NPY magic")?;
-    if magic != MAGIC {
-        return Err(c.invalid_at(0, "NPY magic", format!("{magic:02x?}"), "\\x93NUMPY"));
-    }
-    let major = c.u8("NPY major version")?;
-    let _minor = c.u8("NPY minor version")?;
-    let hlen = match major {
-        1 => c.u16(Endian::Little, "NPY header length")? as u64,
-        2 | 3 => c.u32(Endian::Little, "NPY header length")? as u64,
-        v => return Err(c.invalid_at(6, "NPY major version", v, "1, 2 or 3")),
-    };
-    let hpos = c.pos;
-    let header = c.utf8(hlen, "NPY header")?;
-    let h = Header::parse(header).map_err(|e| {
-        c.invalid_at(
-            hpos,
-            "NPY header",
-            e,
-            "a dict literal with 'descr', 'fortran_order' and 'shape'",
-        )
-    })?;
+    let (h, hpos) = header(c)?;
     let (dtype, endian) = descr(&h.descr).ok_or_else(|| {
         c.invalid_at(
             hpos,
@@ -157,6 +137,207 @@ pub(crate) fn parse(c: &mut Cursor, name: &str, prefixed: bool) -> Result<Vec<Ch
     c.pos = start + (rows * cols * size) as usize;
     c.channel = None;
     Ok(channels)
+}
+
+/// One whole array as the finite-element matrices file ([`crate::fe_matrices`]) takes it:
+/// its shape as stored and its elements in C (row-major) order whatever the file's order.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Array {
+    /// `f8` in either byte order.
+    F64 {
+        /// The shape.
+        shape: Vec<u64>,
+        /// The elements, row-major.
+        data: Vec<f64>,
+    },
+    /// Fixed-width text: `U<w>` (UTF-32, as numpy saves a list of `str`) or `S<w>` (bytes,
+    /// UTF-8 here), trailing NULs removed as numpy removes them.
+    Text {
+        /// The shape.
+        shape: Vec<u64>,
+        /// The strings, row-major.
+        data: Vec<String>,
+    },
+    /// Any other dtype (refused by the caller, who names the member and what it allows).
+    Other {
+        /// The `descr` as written (`'<f4'`, `'|O'`, ...).
+        descr: String,
+        /// The shape.
+        shape: Vec<u64>,
+    },
+}
+
+/// Parses one whole array at the cursor ([`Array`]); `name` names it in messages. The data
+/// size is checked against the buffer before anything is allocated.
+pub(crate) fn parse_array(c: &mut Cursor, name: &str) -> Result<Array, ReadError> {
+    c.channel = Some(name.to_string());
+    let (h, _) = header(c)?;
+    let (order, t) = h.descr.split_at_checked(1).unwrap_or(("", ""));
+    let endian = match order {
+        "<" | "|" | "=" => Some(Endian::Little),
+        ">" => Some(Endian::Big),
+        _ => None,
+    };
+    // the element's kind and size in bytes
+    let width = |digits: &str| -> Option<u64> {
+        // (a zero width, which numpy never writes, would let any count fit in no bytes)
+        (!digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()))
+            .then(|| digits.parse::<u64>().ok())
+            .flatten()
+            .filter(|&w| w > 0)
+    };
+    enum Kind {
+        F64,
+        Utf32(u64),
+        Bytes(u64),
+    }
+    let kind = match (endian, t) {
+        (Some(_), "f8") => Some(Kind::F64),
+        (Some(_), t) => match (t.strip_prefix('U'), t.strip_prefix('S')) {
+            (Some(w), _) => width(w).map(Kind::Utf32),
+            (_, Some(w)) => width(w).map(Kind::Bytes),
+            _ => None,
+        },
+        _ => None,
+    };
+    let (Some(kind), Some(endian)) = (kind, endian) else {
+        c.channel = None;
+        return Ok(Array::Other {
+            descr: h.descr,
+            shape: h.shape,
+        });
+    };
+    let size = match kind {
+        Kind::F64 => Some(8),
+        Kind::Utf32(w) => w.checked_mul(4),
+        Kind::Bytes(w) => Some(w),
+    };
+    let start = c.pos;
+    let count = h.shape.iter().try_fold(1u64, |n, &d| n.checked_mul(d));
+    let need = count.and_then(|n| size.and_then(|s| n.checked_mul(s)));
+    let (count, size) = match (count, size, need) {
+        (Some(n), Some(s), Some(b)) if b <= c.remaining() as u64 => (n as usize, s as usize),
+        _ => {
+            return Err(ReadError::Truncated {
+                file: c.file.to_string(),
+                channel: Some(name.to_string()),
+                offset: c.offset(),
+                what: c.describe(
+                    &format!("NPY data of shape {:?} {:?}", h.shape, h.descr),
+                    start,
+                ),
+                need: need.unwrap_or(u64::MAX),
+                available: c.remaining() as u64,
+            })
+        }
+    };
+    let bytes = c.take((count * size) as u64, "NPY data")?;
+    // Fortran order: element k of the file is the one whose first index runs fastest;
+    // its place in C order, from the C-order stride of each axis.
+    // (with no element, no stride is needed: a zero dimension lets the others be anything)
+    let fortran = h.fortran_order && h.shape.len() > 1 && count > 0;
+    let dims: Vec<usize> = h.shape.iter().map(|&d| d as usize).collect();
+    let mut c_strides = vec![1usize; dims.len()];
+    if fortran {
+        // each stride is at most the element count, which fits
+        for a in (0..dims.len().saturating_sub(1)).rev() {
+            c_strides[a] = c_strides[a + 1] * dims[a + 1];
+        }
+    }
+    let row_major = |k: usize| -> usize {
+        if !fortran {
+            return k;
+        }
+        let (mut rest, mut index) = (k, 0);
+        for (&d, &s) in dims.iter().zip(&c_strides) {
+            index += (rest % d) * s;
+            rest /= d;
+        }
+        index
+    };
+    let array = match kind {
+        Kind::F64 => {
+            let mut data = vec![0.0; count];
+            for (k, b) in bytes.chunks_exact(8).enumerate() {
+                let a: [u8; 8] = b.try_into().expect("8 bytes");
+                data[row_major(k)] = match endian {
+                    Endian::Little => f64::from_le_bytes(a),
+                    Endian::Big => f64::from_be_bytes(a),
+                };
+            }
+            Array::F64 {
+                shape: h.shape,
+                data,
+            }
+        }
+        Kind::Utf32(_) | Kind::Bytes(_) => {
+            let mut data = vec![String::new(); count];
+            for (k, b) in bytes.chunks_exact(size).enumerate() {
+                let at = start + k * size;
+                let text = match kind {
+                    Kind::Utf32(_) => {
+                        let mut s = String::new();
+                        for u in b.chunks_exact(4) {
+                            let a: [u8; 4] = u.try_into().expect("4 bytes");
+                            let v = match endian {
+                                Endian::Little => u32::from_le_bytes(a),
+                                Endian::Big => u32::from_be_bytes(a),
+                            };
+                            match char::from_u32(v) {
+                                Some(ch) => s.push(ch),
+                                None => {
+                                    return Err(c.invalid_at(
+                                        at,
+                                        &format!("NPY string {k}"),
+                                        format!("the code point {v:#x}"),
+                                        "Unicode scalar values (UTF-32)",
+                                    ))
+                                }
+                            }
+                        }
+                        s
+                    }
+                    _ => std::str::from_utf8(b)
+                        .map_err(|_| c.not_utf8(at, &format!("NPY string {k}"), b))?
+                        .to_string(),
+                };
+                data[row_major(k)] = text.trim_end_matches('\0').to_string();
+            }
+            Array::Text {
+                shape: h.shape,
+                data,
+            }
+        }
+    };
+    c.channel = None;
+    Ok(array)
+}
+
+/// The magic, version and header of the array at the cursor, which is left at its first
+/// element; with the header's position (for messages).
+fn header(c: &mut Cursor) -> Result<(Header, usize), ReadError> {
+    let magic = c.take(6, "NPY magic")?;
+    if magic != MAGIC {
+        return Err(c.invalid_at(0, "NPY magic", format!("{magic:02x?}"), "\\x93NUMPY"));
+    }
+    let major = c.u8("NPY major version")?;
+    let _minor = c.u8("NPY minor version")?;
+    let hlen = match major {
+        1 => c.u16(Endian::Little, "NPY header length")? as u64,
+        2 | 3 => c.u32(Endian::Little, "NPY header length")? as u64,
+        v => return Err(c.invalid_at(6, "NPY major version", v, "1, 2 or 3")),
+    };
+    let hpos = c.pos;
+    let header = c.utf8(hlen, "NPY header")?;
+    let h = Header::parse(header).map_err(|e| {
+        c.invalid_at(
+            hpos,
+            "NPY header",
+            e,
+            "a dict literal with 'descr', 'fortran_order' and 'shape'",
+        )
+    })?;
+    Ok((h, hpos))
 }
 
 fn descr(d: &str) -> Option<(Dtype, Endian)> {

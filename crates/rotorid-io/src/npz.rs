@@ -47,6 +47,35 @@ fn read_from<R: Read + std::io::Seek, S: Source + ?Sized>(
     size_of_file: u64,
     direct: &S,
 ) -> Result<Table, ReadError> {
+    let mut channels = Vec::new();
+    members(file, input, size_of_file, direct, |name, c| {
+        channels.extend(npy::parse(c, name, true)?);
+        Ok(())
+    })?;
+    if channels.is_empty() {
+        return Err(ReadError::NoChannels {
+            file: file.to_string(),
+            why: "no member NAME.npy".into(),
+        });
+    }
+    Ok(Table {
+        file: file.to_string(),
+        channels,
+        notes: Vec::new(),
+    })
+}
+
+/// Calls `each(NAME, cursor)` on every member `NAME.npy` of the archive `input` of
+/// `size_of_file` bytes, in the archive's order, the cursor over the member's bytes (read
+/// from `direct` when stored, inflated when deflated, each checked as the module doc says);
+/// other members are skipped.
+pub(crate) fn members<R: Read + std::io::Seek, S: Source + ?Sized>(
+    file: &str,
+    input: R,
+    size_of_file: u64,
+    direct: &S,
+    mut each: impl FnMut(&str, &mut Cursor) -> Result<(), ReadError>,
+) -> Result<(), ReadError> {
     let zerr = |channel: Option<&str>, e: zip::result::ZipError| ReadError::Container {
         file: file.to_string(),
         channel: channel.map(str::to_string),
@@ -54,7 +83,6 @@ fn read_from<R: Read + std::io::Seek, S: Source + ?Sized>(
         message: e.to_string(),
     };
     let mut zip = zip::ZipArchive::new(input).map_err(|e| zerr(None, e))?;
-    let mut channels = Vec::new();
     let mut scratch = Vec::new();
     for i in 0..zip.len() {
         let mut member = zip.by_index(i).map_err(|e| zerr(None, e))?;
@@ -114,7 +142,7 @@ fn read_from<R: Read + std::io::Seek, S: Source + ?Sized>(
                 });
             }
             let mut c = Cursor::inflated(file, bytes, at);
-            channels.extend(npy::parse(&mut c, &name, true)?);
+            each(&name, &mut c)?;
             continue;
         }
         let mut buf = Vec::with_capacity(size as usize);
@@ -138,17 +166,7 @@ fn read_from<R: Read + std::io::Seek, S: Source + ?Sized>(
             });
         }
         let mut c = Cursor::inflated(file, &buf, at);
-        channels.extend(npy::parse(&mut c, &name, true)?);
+        each(&name, &mut c)?;
     }
-    if channels.is_empty() {
-        return Err(ReadError::NoChannels {
-            file: file.to_string(),
-            why: "no member NAME.npy".into(),
-        });
-    }
-    Ok(Table {
-        file: file.to_string(),
-        channels,
-        notes: Vec::new(),
-    })
+    Ok(())
 }

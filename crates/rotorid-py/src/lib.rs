@@ -10,10 +10,12 @@
 //! - [`options`]: the method and its settings from keyword arguments.
 //! - [`stream`]: identification of a record, or of a live stream of chunks.
 //! - [`balance`]: multi-plane balancing and trial planning from the two CSV tables.
+//! - [`finite_element`]: a finite-element rotor's scenario joined with its matrices file.
 
 pub mod balance;
 pub mod columns;
 pub mod error;
+pub mod finite_element;
 pub mod options;
 pub mod response;
 pub mod scenario;

@@ -403,6 +403,93 @@ fn read(
     Ok((d, units))
 }
 
+/// `m` (n x n, SI) as a 2-D float64 array.
+fn matrix<'py>(py: Python<'py>, n: usize, row_major: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
+    Ok(PyArray1::from_vec(py, row_major)
+        .reshape([n, n])?
+        .into_any())
+}
+
+/// The matrices file `path` as stored (`rotorid_io::fe_matrices`): a dict of `dofs` (list
+/// of str) and `M`, `K`, `G`, `C`, `Ka` (n x n float64 arrays; `C`, `Ka` None when absent).
+#[pyfunction]
+fn read_fe_matrices(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyDict>> {
+    let path = path.to_string_lossy().into_owned();
+    let f = py
+        .detach(|| crate::finite_element::read_matrices(&path))
+        .map_err(py_err)?;
+    let n = f.n();
+    let d = PyDict::new(py);
+    d.set_item("dofs", &f.dofs)?;
+    d.set_item("M", matrix(py, n, f.m)?)?;
+    d.set_item("K", matrix(py, n, f.k)?)?;
+    d.set_item("G", matrix(py, n, f.g)?)?;
+    d.set_item("C", f.c.map(|c| matrix(py, n, c)).transpose()?)?;
+    d.set_item("Ka", f.ka.map(|ka| matrix(py, n, ka)).transpose()?)?;
+    Ok(d)
+}
+
+/// The finite-element rotor of the scenario TOML `path` (`rotor.model =
+/// "finite_element"`) joined with its matrices file, every check the library's: a dict of
+/// `matrices` (the path read), `dofs`, `M`, `K`, `G`, `C`, `Ka` (as checked), `bearings`
+/// (dicts of node, kxx .. cyy) and `unbalances` (dicts of node, mud [kg m], alpha [rad]).
+#[pyfunction]
+fn load_finite_element(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyDict>> {
+    let path = path.to_string_lossy().into_owned();
+    let (r, matrices) = py
+        .detach(|| crate::finite_element::load(&path))
+        .map_err(py_err)?;
+    let m = &r.matrices;
+    let n = m.n();
+    let rows = |a: &nalgebra::DMatrix<f64>| a.transpose().as_slice().to_vec();
+    let d = PyDict::new(py);
+    d.set_item("matrices", matrices)?;
+    d.set_item(
+        "dofs",
+        m.dofs().iter().map(|x| x.to_string()).collect::<Vec<_>>(),
+    )?;
+    d.set_item("M", matrix(py, n, rows(m.m()))?)?;
+    d.set_item("K", matrix(py, n, rows(m.k()))?)?;
+    d.set_item("G", matrix(py, n, rows(m.g()))?)?;
+    d.set_item("C", m.c().map(|c| matrix(py, n, rows(c))).transpose()?)?;
+    d.set_item("Ka", m.ka().map(|c| matrix(py, n, rows(c))).transpose()?)?;
+    let bearings = r
+        .bearings
+        .iter()
+        .map(|b| {
+            let e = PyDict::new(py);
+            e.set_item("node", b.node)?;
+            for (k, v) in [
+                ("kxx", b.kxx),
+                ("kxy", b.kxy),
+                ("kyx", b.kyx),
+                ("kyy", b.kyy),
+                ("cxx", b.cxx),
+                ("cxy", b.cxy),
+                ("cyx", b.cyx),
+                ("cyy", b.cyy),
+            ] {
+                e.set_item(k, v)?;
+            }
+            Ok(e)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    d.set_item("bearings", bearings)?;
+    let unbalances = r
+        .unbalances
+        .iter()
+        .map(|u| {
+            let e = PyDict::new(py);
+            e.set_item("node", u.node)?;
+            e.set_item("mud", u.mud)?;
+            e.set_item("alpha", u.alpha)?;
+            Ok(e)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    d.set_item("unbalances", unbalances)?;
+    Ok(d)
+}
+
 /// What the reader noted about the file at `path` (an interrupted recording's unfinished
 /// chunk), each as a `UserWarning`.
 fn warn_notes(py: Python<'_>, path: &str, notes: &[String]) -> PyResult<()> {
@@ -727,6 +814,8 @@ fn rotorid_extension(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBlocks>()?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;
     m.add_function(wrap_pyfunction!(balance, m)?)?;
+    m.add_function(wrap_pyfunction!(read_fe_matrices, m)?)?;
+    m.add_function(wrap_pyfunction!(load_finite_element, m)?)?;
     m.add("METHODS", options::METHOD_NAMES.to_vec())?;
     m.add("UNKNOWNS", options::UNKNOWN_NAMES.to_vec())?;
     m.add("MODELS", options::MODEL_NAMES.to_vec())?;

@@ -532,7 +532,7 @@ mod tests {
                 e,
                 format!(
                     "Scenario(): rotor.model = \"{name}\" is not a rotor model: must be \
-                     \"jeffcott\" or \"cross_coupled\""
+                     \"jeffcott\", \"cross_coupled\" or \"finite_element\""
                 )
             );
         }

@@ -1,5 +1,7 @@
 //! `rotorid inspect FILE`: the channels of a record in any format rotorid reads, with
-//! their length, unit, sample rate and range, so a user can pick `--columns`.
+//! their length, unit, sample rate and range, so a user can pick `--columns`; or, for a
+//! scenario `.toml` of a finite-element rotor, the rotor its matrices file and `[rotor]`
+//! make (degrees of freedom, bearings, unbalances), so a user sees it loads.
 
 use std::fmt::Write as _;
 
@@ -8,7 +10,8 @@ use crate::io::tables;
 /// Arguments of `rotorid inspect`.
 #[derive(Debug, clap::Args)]
 pub struct InspectArgs {
-    /// A .csv, .mat, .tdms, .uff/.unv/.58, .npy, .npz or .parquet file.
+    /// A .csv, .mat, .tdms, .uff/.unv/.58, .npy, .npz or .parquet file; or a scenario .toml
+    /// of a finite-element rotor.
     #[arg(value_name = "FILE")]
     pub file: String,
 }
@@ -58,6 +61,12 @@ impl Summary {
 /// block of rows at a time (`rotorid_io::stream`), so a recording of any length can be
 /// inspected; the others are read whole.
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
+    let toml = std::path::Path::new(&args.file)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if toml {
+        return finite_element(&args.file);
+    }
     let (file, channels) = match rotorid_io::open_blocks(&args.file)? {
         Some(reader) => streamed(&args.file, reader)?,
         None => {
@@ -261,4 +270,63 @@ mod tests {
         assert_eq!(extremes(&nans).2, 11);
         assert!(extremes(&nans).0.is_infinite() && extremes(&nans).1.is_infinite());
     }
+}
+
+/// `rotorid inspect fe.toml`: the finite-element rotor of a scenario, as its matrices file
+/// and `[rotor]` make it.
+fn finite_element(path: &str) -> anyhow::Result<()> {
+    let r = crate::io::finite_element::load_finite_element(path)?;
+    let m = &r.matrices;
+    let mut nodes: Vec<u32> = m.dofs().iter().map(|d| d.node).collect();
+    nodes.dedup();
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{path}: finite-element rotor, {} degrees of freedom at {} nodes ({} .. {}); \
+         C: {}, Ka: {}",
+        m.n(),
+        nodes.len(),
+        m.dofs().iter().map(|d| d.node).min().unwrap_or(0),
+        m.dofs().iter().map(|d| d.node).max().unwrap_or(0),
+        if m.c().is_some() { "given" } else { "none" },
+        if m.ka().is_some() { "given" } else { "none" },
+    );
+    let _ = writeln!(
+        out,
+        "  {:<12} {:>5} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13}",
+        "bearing",
+        "node",
+        "kxx [N/m]",
+        "kxy [N/m]",
+        "kyx [N/m]",
+        "kyy [N/m]",
+        "cxx [N s/m]",
+        "cxy [N s/m]",
+        "cyx [N s/m]",
+        "cyy [N s/m]"
+    );
+    for (i, b) in r.bearings.iter().enumerate() {
+        let _ = write!(out, "  {:<12} {:>5}", format!("bearing{i}"), b.node);
+        for v in [b.kxx, b.kxy, b.kyx, b.kyy, b.cxx, b.cxy, b.cyx, b.cyy] {
+            let _ = write!(out, " {v:>13.6e}");
+        }
+        let _ = writeln!(out);
+    }
+    let _ = writeln!(
+        out,
+        "  {:<12} {:>5} {:>13} {:>13}",
+        "unbalance", "node", "mud [kg m]", "alpha [deg]"
+    );
+    for (j, u) in r.unbalances.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "  {:<12} {:>5} {:>13.6e} {:>13.6}",
+            format!("unbalance{j}"),
+            u.node,
+            u.mud,
+            u.alpha.to_degrees()
+        );
+    }
+    out!("{out}")?;
+    Ok(())
 }

@@ -295,3 +295,92 @@ fn an_endless_pipe_is_refused_after_one_mib() {
     // The pipe holds at most a few buffers beyond what rotorid read.
     assert!(written < 4 << 20, "{written} bytes written");
 }
+
+/// A finite-element scenario beside numpy's matrices file (rotorid-io's fixture, written by
+/// numpy.savez: dofs 0.x .. 0.ry, 3.x .. 3.ry).
+fn finite_element_dir(bearing1_node: u32) -> (tempfile::TempDir, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let npz = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../rotorid-io/fixtures/fe/savez.npz");
+    std::fs::create_dir(dir.path().join("m")).unwrap();
+    std::fs::copy(npz, dir.path().join("m/rotor.npz")).unwrap();
+    let toml = dir.path().join("fe.toml");
+    std::fs::write(
+        &toml,
+        format!(
+            "[rotor]\nmodel = \"finite_element\"\nmatrices = \"m/rotor.npz\"\n\
+             [[rotor.bearing]]\nnode = 0\nkxx = 1.0e6\nkyy = 1.2e6\ncxx = 300.0\ncyy = 310.0\n\
+             [[rotor.bearing]]\nnode = {bearing1_node}\nkxx = 2.0e6\nkxy = -3.0e4\nkyy = 2.5e6\n\
+             [[rotor.unbalance]]\nnode = 3\nm_u = 1.0e-4\nd = 0.1\nalpha_deg = 45.0\n"
+        ),
+    )
+    .unwrap();
+    let p = toml.to_str().unwrap().to_owned();
+    (dir, p)
+}
+
+#[test]
+fn a_finite_element_scenario_loads_with_its_matrices_and_simulate_names_the_model() {
+    let (_dir, toml) = finite_element_dir(3);
+    let out = rotorid().args(["inspect", &toml]).output().unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.starts_with(&format!(
+            "{toml}: finite-element rotor, 8 degrees of freedom at 2 nodes (0 .. 3); C: given, Ka: given"
+        )),
+        "{text}"
+    );
+    let row = |name: &str| {
+        text.lines()
+            .find(|l| l.trim_start().starts_with(name))
+            .unwrap_or_else(|| panic!("no {name} in\n{text}"))
+            .split_whitespace()
+            .skip(1)
+            .map(|v| v.parse::<f64>().unwrap())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        row("bearing0 "),
+        [0.0, 1.0e6, 0.0, 0.0, 1.2e6, 300.0, 0.0, 0.0, 310.0]
+    );
+    assert_eq!(
+        row("bearing1 "),
+        [3.0, 2.0e6, -3.0e4, 0.0, 2.5e6, 0.0, 0.0, 0.0, 0.0]
+    );
+    let u = row("unbalance0 ");
+    assert_eq!(u[0], 3.0);
+    assert!(
+        (u[1] - 1.0e-5).abs() < 1e-16 && (u[2] - 45.0).abs() < 1e-9,
+        "{u:?}"
+    );
+    // simulate does not take a finite-element rotor (yet): it says so, naming the model
+    let out = simulate(&toml, &[]);
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(!out.status.success());
+    assert!(
+        err.contains(&format!(
+            "{toml}:1: rotor.model = \"finite_element\": simulate does not take a finite-element rotor"
+        )),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_finite_element_scenario_on_a_node_without_dofs_is_refused_naming_both_files() {
+    let (_dir, toml) = finite_element_dir(5);
+    let out = rotorid().args(["inspect", &toml]).output().unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        err.contains(&format!(
+            "{toml}:11: rotor.bearing[1].node = 5: the matrices file "
+        )) && err.contains("m/rotor.npz has no degree of freedom 5.x in dofs"),
+        "{err}"
+    );
+}

@@ -36,6 +36,7 @@ Balancing (influence coefficients of many planes, sensors and speeds)::
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from typing import Any, Iterator, Mapping, Sequence
 
@@ -61,12 +62,14 @@ __all__ = [
     "MODELS",
     "UNKNOWNS",
     "Balance",
+    "FiniteElementRotor",
     "Identification",
     "Scenario",
     "Session",
     "TrialPlan",
     "balance",
     "identify",
+    "load_finite_element",
     "plan_trials",
     "read",
     "read_blocks",
@@ -84,6 +87,46 @@ def _scenario(sc: Scenario | str | os.PathLike[str]) -> Scenario:
     if isinstance(sc, (str, os.PathLike)):
         return Scenario.load(os.fspath(sc))
     raise TypeError(f"scenario: expected a rotorid.Scenario, 'table1' or a path, got {type(sc).__name__}")
+
+
+@dataclasses.dataclass(frozen=True)
+class FiniteElementRotor:
+    """A finite-element rotor as rotorid loads it (``docs/formats.md``): the shaft and disks
+    as matrices, one row and column per degree of freedom ``dofs`` (``<node>.<dof>``, dof
+    one of x, y [m], rx, ry [rad]), and the bearings and unbalances of its scenario.
+
+    Attributes:
+        matrices: the path of the matrices file read (relative to the scenario's directory).
+        dofs: the names of the rows and columns.
+        M: mass [kg, kg m, kg m^2]; K: stiffness of the shaft and disks, no bearings [N/m,
+            N, N m/rad]; G: gyroscopic, multiplied by phi' [kg, kg m, kg m^2]; each n x n.
+        C: shaft damping [N s/m, ...], or None; Ka: the matrix multiplied by phi'' (ROSS's
+            Ksdt), or None.
+        bearings: per ``[[rotor.bearing]]`` (bearing0, ...): node, kxx, kxy, kyx, kyy [N/m],
+            cxx, cxy, cyx, cyy [N s/m].
+        unbalances: per ``[[rotor.unbalance]]`` (unbalance0, ...): node, mud [kg m], alpha
+            [rad] (its angle at phi = 0 from +x towards +y).
+    """
+
+    matrices: str
+    dofs: list[str]
+    M: np.ndarray
+    K: np.ndarray
+    G: np.ndarray
+    C: np.ndarray | None
+    Ka: np.ndarray | None
+    bearings: list[dict[str, float]]
+    unbalances: list[dict[str, float]]
+
+
+def load_finite_element(scenario: str | os.PathLike[str]) -> FiniteElementRotor:
+    """Load the finite-element rotor of a scenario TOML (``rotor.model =
+    "finite_element"``): its matrices file (``rotor.matrices``, relative to the scenario)
+    read and checked (members, shapes, dtypes; dof names; M symmetric and positive
+    definite; every entry finite) and its bearings and unbalances checked and placed on
+    it, as the ``rotorid`` command loads it. Raises ``ValueError`` naming the file, the
+    line or member and what is allowed, ``FileNotFoundError`` for a missing file."""
+    return FiniteElementRotor(**_rotorid.load_finite_element(os.fspath(scenario)))
 
 
 def _frame(columns: Mapping[str, np.ndarray]) -> pd.DataFrame:

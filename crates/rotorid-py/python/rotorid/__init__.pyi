@@ -1,5 +1,6 @@
 """Type stubs of rotorid (SI units throughout; see the docstrings)."""
 
+import dataclasses
 import os
 from typing import Any, Iterator, Mapping, Sequence, final
 
@@ -19,12 +20,14 @@ __all__ = [
     "MODELS",
     "UNKNOWNS",
     "Balance",
+    "FiniteElementRotor",
     "Identification",
     "Scenario",
     "Session",
     "TrialPlan",
     "balance",
     "identify",
+    "load_finite_element",
     "plan_trials",
     "read",
     "read_blocks",
@@ -170,3 +173,17 @@ class Session:
     ) -> pd.DataFrame: ...
     def start_now(self) -> pd.DataFrame: ...
     def finish(self, *, input: str | None = None, scenario: str | None = None) -> Identification: ...
+
+@dataclasses.dataclass(frozen=True)
+class FiniteElementRotor:
+    matrices: str
+    dofs: list[str]
+    M: np.ndarray
+    K: np.ndarray
+    G: np.ndarray
+    C: np.ndarray | None
+    Ka: np.ndarray | None
+    bearings: list[dict[str, float]]
+    unbalances: list[dict[str, float]]
+
+def load_finite_element(scenario: str | os.PathLike[str]) -> FiniteElementRotor: ...

@@ -6,7 +6,7 @@ import numpy as np
 
 from . import Scenario as Scenario
 
-__all__ = ["ESTIMATE_COLUMNS", "ESTIMATE_COLUMNS_BY_MODEL", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "read", "read_blocks", "simulate"]
+__all__ = ["ESTIMATE_COLUMNS", "ESTIMATE_COLUMNS_BY_MODEL", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "load_finite_element", "read", "read_blocks", "read_fe_matrices", "simulate"]
 
 METHODS: list[str]
 MODELS: list[str]
@@ -29,6 +29,8 @@ def simulate(
 ) -> dict[str, np.ndarray]: ...
 def read(path: str, columns: str | None = None) -> tuple[dict[str, np.ndarray], dict[str, str]]: ...
 def read_blocks(path: str, columns: str | None = None, rows: int = 65536) -> Blocks: ...
+def read_fe_matrices(path: str) -> dict[str, Any]: ...
+def load_finite_element(path: str) -> dict[str, Any]: ...
 @final
 class Blocks:
     @property

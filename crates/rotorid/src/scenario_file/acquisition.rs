@@ -59,26 +59,26 @@ type Rows = (Vec<Vec<f64>>, Option<usize>);
 
 /// A table in either TOML form.
 #[derive(Clone, Copy)]
-enum Node<'a> {
+pub(super) enum Node<'a> {
     Table(&'a Table),
     Inline(&'a InlineTable),
 }
 
 /// A value in either form.
 #[derive(Clone, Copy)]
-enum Val<'a> {
+pub(super) enum Val<'a> {
     Item(&'a Item),
     Value(&'a Value),
 }
 
 impl<'a> Val<'a> {
-    fn value(self) -> Option<&'a Value> {
+    pub(super) fn value(self) -> Option<&'a Value> {
         match self {
             Val::Item(i) => i.as_value(),
             Val::Value(v) => Some(v),
         }
     }
-    fn table(self) -> Option<Node<'a>> {
+    pub(super) fn table(self) -> Option<Node<'a>> {
         match self {
             Val::Item(Item::Table(t)) => Some(Node::Table(t)),
             Val::Item(Item::Value(Value::InlineTable(t))) | Val::Value(Value::InlineTable(t)) => {
@@ -87,7 +87,7 @@ impl<'a> Val<'a> {
             _ => None,
         }
     }
-    fn span(self) -> Option<std::ops::Range<usize>> {
+    pub(super) fn span(self) -> Option<std::ops::Range<usize>> {
         match self {
             Val::Item(Item::Table(t)) => t.span(),
             Val::Item(i) => i.as_value().and_then(Value::span),
@@ -97,7 +97,7 @@ impl<'a> Val<'a> {
 }
 
 impl<'a> Node<'a> {
-    fn entries(self) -> Vec<(&'a str, Option<&'a Key>, Val<'a>)> {
+    pub(super) fn entries(self) -> Vec<(&'a str, Option<&'a Key>, Val<'a>)> {
         match self {
             Node::Table(t) => t.iter().map(|(k, i)| (k, t.key(k), Val::Item(i))).collect(),
             Node::Inline(t) => t
@@ -144,14 +144,14 @@ const SIMULATE: [&str; 16] = [
 ];
 
 /// The checked entries of one table: (key, line, value).
-struct Entries<'a> {
-    path: String,
-    line: Option<usize>,
-    items: Vec<(&'a str, Option<usize>, Val<'a>)>,
+pub(super) struct Entries<'a> {
+    pub(super) path: String,
+    pub(super) line: Option<usize>,
+    pub(super) items: Vec<(&'a str, Option<usize>, Val<'a>)>,
 }
 
 impl<'a> Entries<'a> {
-    fn get(&self, k: &str) -> Option<(Option<usize>, Val<'a>)> {
+    pub(super) fn get(&self, k: &str) -> Option<(Option<usize>, Val<'a>)> {
         self.items
             .iter()
             .find(|(n, _, _)| *n == k)
@@ -160,7 +160,7 @@ impl<'a> Entries<'a> {
 }
 
 impl Parser<'_> {
-    fn err_type(
+    pub(super) fn err_type(
         &self,
         line: Option<usize>,
         key: &str,
@@ -176,7 +176,7 @@ impl Parser<'_> {
         }
     }
 
-    fn range(
+    pub(super) fn range(
         &self,
         line: Option<usize>,
         key: &str,
@@ -192,7 +192,7 @@ impl Parser<'_> {
         }
     }
 
-    fn missing(&self, e: &Entries<'_>, key: &str, what: &str) -> ScenarioFileError {
+    pub(super) fn missing(&self, e: &Entries<'_>, key: &str, what: &str) -> ScenarioFileError {
         ScenarioFileError::MissingKey {
             origin: self.origin.to_owned(),
             line: e.line,
@@ -202,7 +202,7 @@ impl Parser<'_> {
     }
 
     /// The entries of `node`, every key among `allowed`.
-    fn entries<'a>(
+    pub(super) fn entries<'a>(
         &self,
         path: &str,
         line: Option<usize>,
@@ -231,7 +231,7 @@ impl Parser<'_> {
         })
     }
 
-    fn table_of<'a>(
+    pub(super) fn table_of<'a>(
         &self,
         path: &str,
         line: Option<usize>,
@@ -242,7 +242,7 @@ impl Parser<'_> {
     }
 
     /// A number with its check; `allowed` names the range and unit.
-    fn num(
+    pub(super) fn num(
         &self,
         e: &Entries<'_>,
         k: &str,
@@ -264,7 +264,7 @@ impl Parser<'_> {
         Ok(Some((x, line)))
     }
 
-    fn string(
+    pub(super) fn string(
         &self,
         e: &Entries<'_>,
         k: &str,
@@ -317,6 +317,33 @@ impl Parser<'_> {
         Ok(Some((rows, line)))
     }
 
+    /// The tables of an array of tables `path` (`[[path]]` sections, or an array of inline
+    /// tables), each with its line (that of `pl`, the key's, for inline ones).
+    pub(super) fn array_of_tables<'a>(
+        &self,
+        path: &str,
+        pl: Option<usize>,
+        pv: Val<'a>,
+    ) -> Result<Vec<(Node<'a>, Option<usize>)>, ScenarioFileError> {
+        let bad = || self.err_type(pl, path, pv, &format!("an array of tables [[{path}]]"));
+        match pv {
+            Val::Item(Item::ArrayOfTables(a)) => Ok(a
+                .iter()
+                .map(|t| (Node::Table(t), t.span().map(|s| self.line(s.start)).or(pl)))
+                .collect()),
+            _ => match pv.value() {
+                Some(Value::Array(a)) => a
+                    .iter()
+                    .map(|x| match x {
+                        Value::InlineTable(t) => Ok((Node::Inline(t), pl)),
+                        _ => Err(bad()),
+                    })
+                    .collect(),
+                _ => Err(bad()),
+            },
+        }
+    }
+
     /// `[acquisition]` (module doc).
     pub(super) fn acquisition(
         &self,
@@ -352,39 +379,7 @@ impl Parser<'_> {
                 "two [[acquisition.probe]] tables: column, angle_deg, sensitivity",
             ));
         };
-        let tables: Vec<(Node<'_>, Option<usize>)> = match pv {
-            Val::Item(Item::ArrayOfTables(a)) => a
-                .iter()
-                .map(|t| (Node::Table(t), t.span().map(|s| self.line(s.start)).or(pl)))
-                .collect(),
-            _ => match pv.value() {
-                Some(Value::Array(a)) => {
-                    let mut v = Vec::new();
-                    for x in a.iter() {
-                        match x {
-                            Value::InlineTable(t) => v.push((Node::Inline(t), pl)),
-                            _ => {
-                                return Err(self.err_type(
-                                    pl,
-                                    "acquisition.probe",
-                                    pv,
-                                    "an array of tables [[acquisition.probe]]",
-                                ))
-                            }
-                        }
-                    }
-                    v
-                }
-                _ => {
-                    return Err(self.err_type(
-                        pl,
-                        "acquisition.probe",
-                        pv,
-                        "an array of tables [[acquisition.probe]]",
-                    ))
-                }
-            },
-        };
+        let tables = self.array_of_tables("acquisition.probe", pl, pv)?;
         if tables.len() != 2 {
             return Err(ScenarioFileError::Inconsistent {
                 origin: self.origin.to_owned(),

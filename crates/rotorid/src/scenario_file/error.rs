@@ -76,9 +76,9 @@ pub enum ScenarioFileError {
         key: String,
         /// The section's keys, comma-separated.
         allowed: String,
-        /// The model whose key it is, when it is another model's rotor key
-        /// (the message then says `kxx is a key of rotor.model = "cross_coupled"`).
-        other_model: Option<crate::parameter::ModelKind>,
+        /// The model whose key it is, when it is another model's rotor key (the message
+        /// then says `kxx is a key of rotor.model = "cross_coupled"`).
+        other_model: Option<RotorModel>,
     },
     /// A value of the wrong TOML type (`rotor.m = "heavy"`).
     #[error(
@@ -147,8 +147,8 @@ pub enum ScenarioFileError {
     },
     /// `rotor.model` is a string but not a model.
     #[error(
-        "{}: rotor.model = \"{value}\" is not a rotor model: must be \"jeffcott\" or \
-         \"cross_coupled\"",
+        "{}: rotor.model = \"{value}\" is not a rotor model: must be \"jeffcott\", \
+         \"cross_coupled\" or \"finite_element\"",
         At(origin, line)
     )]
     UnknownModel {
@@ -158,6 +158,21 @@ pub enum ScenarioFileError {
         line: Option<usize>,
         /// The string written.
         value: String,
+    },
+    /// A view that takes a lumped rotor (jeffcott or cross_coupled) asked of a scenario
+    /// whose rotor is a finite-element one ([`super::ScenarioSpec::finite_element`]).
+    #[error(
+        "{}: rotor.model = \"finite_element\": {who} does not take a finite-element rotor \
+         (only rotor.model = \"jeffcott\" or \"cross_coupled\")",
+        At(origin, line)
+    )]
+    FiniteElementRotor {
+        /// The file name.
+        origin: String,
+        /// The line of `rotor.model`.
+        line: Option<usize>,
+        /// What asked for the lumped rotor (`simulate`, `identify`).
+        who: String,
     },
     /// `speed.kind` is a string but not a speed profile.
     #[error(
@@ -273,6 +288,25 @@ pub enum ScenarioFileError {
     },
 }
 
+/// A value of `rotor.model`: a lumped model or the finite-element rotor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RotorModel {
+    /// `jeffcott` or `cross_coupled`.
+    Lumped(crate::parameter::ModelKind),
+    /// `finite_element`.
+    FiniteElement,
+}
+
+impl RotorModel {
+    /// Its name in `rotor.model`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Lumped(m) => m.name(),
+            Self::FiniteElement => super::FINITE_ELEMENT,
+        }
+    }
+}
+
 impl ScenarioFileError {
     /// The file name (or `table1`) the error is about.
     pub fn origin(&self) -> &str {
@@ -293,6 +327,7 @@ impl ScenarioFileError {
             | Self::MissingSamplingKey { origin, .. }
             | Self::MissingKey { origin, .. }
             | Self::DampingNotDissipative { origin, .. }
+            | Self::FiniteElementRotor { origin, .. }
             | Self::UnknownModel { origin, .. } => origin,
         }
     }
@@ -313,6 +348,7 @@ impl ScenarioFileError {
             | Self::MissingSpeedKey { line, .. }
             | Self::MissingKey { line, .. }
             | Self::DampingNotDissipative { line, .. }
+            | Self::FiniteElementRotor { line, .. }
             | Self::UnknownModel { line, .. } => *line,
             Self::MissingSection { .. }
             | Self::MissingRotorKey { .. }

@@ -38,6 +38,13 @@
 //! one with zero cross terms, and a cross-coupled rotor's direct coefficients are the
 //! Jeffcott model's cx, kx, cz, kz.
 //!
+//! `rotor.model = "finite_element"` (issue 27) is a rotor whose shaft and disks come as
+//! matrices: `[rotor]` then holds `matrices` (the path of the matrices file, relative to
+//! the scenario file), `[[rotor.bearing]]` and `[[rotor.unbalance]]` tables
+//! ([`FiniteElementSpec`], whose module doc lists the keys). The caller reads the matrices
+//! file and joins it with the spec ([`FiniteElementSpec::rotor`]); the lumped rotor's
+//! views below refuse such a scenario, naming the model.
+//!
 //! Any form of TOML that names the same keys is the same file: dotted keys
 //! (`rotor.m = 14.29`, `speed.kind = "constant"` at the top), inline tables
 //! (`sampling = { dt = 1.0e-4, duration = 1.0 }`) and sections may be mixed, one form per
@@ -68,12 +75,14 @@
 
 mod acquisition;
 mod error;
+mod finite_element;
 mod parse;
 
 use std::collections::BTreeMap;
 use std::fmt;
 
-pub use error::ScenarioFileError;
+pub use error::{RotorModel, ScenarioFileError};
+pub use finite_element::{FiniteElementSpec, FINITE_ELEMENT};
 
 use crate::model::{CrossCoupling, ModelError};
 use crate::parameter::ModelKind;
@@ -220,6 +229,8 @@ pub struct ScenarioSpec {
     sampling: Option<Section>,
     initial: Section,
     acquisition: Option<crate::acquisition::Acquisition>,
+    /// The rotor when `rotor.model = "finite_element"` (then `rotor` holds no key).
+    finite_element: Option<FiniteElementSpec>,
 }
 
 /// Command-line values that take precedence over the scenario file in `simulate`.
@@ -292,6 +303,7 @@ impl ScenarioSpec {
             sampling: None,
             initial: Section::default(),
             acquisition: None,
+            finite_element: None,
         }
     }
 
@@ -300,6 +312,26 @@ impl ScenarioSpec {
     /// written, relative to the scenario file.
     pub fn acquisition(&self) -> Option<&crate::acquisition::Acquisition> {
         self.acquisition.as_ref()
+    }
+
+    /// The finite-element rotor's `[rotor]` (its matrices file as written, relative to the
+    /// scenario file, its bearings and unbalances), when `rotor.model = "finite_element"`;
+    /// the lumped rotor's views ([`Self::simulation`], [`Self::identification`],
+    /// [`Self::rotor`]) then refuse the scenario.
+    pub fn finite_element(&self) -> Option<&FiniteElementSpec> {
+        self.finite_element.as_ref()
+    }
+
+    /// The error of a lumped rotor's view `who` of a finite-element scenario.
+    fn refuse_finite_element(&self, who: &str) -> Result<(), ScenarioFileError> {
+        match self.finite_element {
+            Some(_) => Err(ScenarioFileError::FiniteElementRotor {
+                origin: self.origin.clone(),
+                line: self.rotor.line,
+                who: who.to_owned(),
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Parse and check the TOML `text`; `origin` (the file name) prefixes every message.
@@ -328,6 +360,7 @@ impl ScenarioSpec {
     /// The complete scenario a simulation needs; `ov` (command-line values) take
     /// precedence.
     pub fn simulation(&self, ov: &SimulationOverrides) -> Result<Scenario, ScenarioFileError> {
+        self.refuse_finite_element("simulate")?;
         let o = &self.origin;
         let mut sc = match &self.builtin {
             Some(s) => Scenario {
@@ -410,6 +443,7 @@ impl ScenarioSpec {
 
     /// What `identify` needs: known a, m_u, d, alpha; optional truth, speed, sampling.
     pub fn identification(&self) -> Result<IdentificationScenario, ScenarioFileError> {
+        self.refuse_finite_element("identify")?;
         if let Some(s) = &self.builtin {
             let rotor = in_model(&s.rotor, self.model);
             let u = rotor.unbalance();
@@ -485,6 +519,7 @@ impl ScenarioSpec {
     /// speed), or the built-in scenario's; `who` needs it (named in the error of a missing
     /// key).
     pub fn rotor(&self, who: &str) -> Result<Rotor, ScenarioFileError> {
+        self.refuse_finite_element(who)?;
         match &self.builtin {
             Some(s) => Ok(s.rotor),
             None => self.rotor_for(who),
@@ -1174,7 +1209,7 @@ duration = 1.0
         let msg = e(&CROSS.replace("\"cross_coupled\"", "\"fluid_film\""));
         assert_eq!(
             msg,
-            "c.toml:3: rotor.model = \"fluid_film\" is not a rotor model: must be \"jeffcott\" or \"cross_coupled\""
+            "c.toml:3: rotor.model = \"fluid_film\" is not a rotor model: must be \"jeffcott\", \"cross_coupled\" or \"finite_element\""
         );
         let msg = e(&CROSS.replace("\"cross_coupled\"", "2"));
         assert!(

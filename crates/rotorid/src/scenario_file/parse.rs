@@ -13,6 +13,8 @@ use std::ops::Range;
 
 use toml_edit::{ImDocument, Item, Key, Value};
 
+use super::error::RotorModel;
+use super::finite_element::{FINITE_ELEMENT, FINITE_ELEMENT_KEYS};
 use super::{
     rotor_error, rotor_keys, unit_of, Num, RotorArray, ScenarioFileError, ScenarioSpec, Section,
     SpeedKind, CANONICAL_ORDER, INITIAL_KEYS, ROTOR_CONTENTS, SAMPLING_KEYS, SECTIONS, SPEED_KEYS,
@@ -99,8 +101,12 @@ impl Parser<'_> {
         // The top level: only the four sections, each a table in any of TOML's forms.
         let mut raw: BTreeMap<&str, (Option<usize>, Vec<Entry<'_>>)> = BTreeMap::new();
         let mut acquisition = None;
+        let mut rotor_item = None;
         for (name, item) in root.iter() {
             let line = self.key_line(root.key(name));
+            if name == "rotor" {
+                rotor_item = Some((item, line));
+            }
             if name == "acquisition" {
                 acquisition = Some(self.acquisition(item, line)?);
                 continue;
@@ -132,16 +138,45 @@ impl Parser<'_> {
             };
             raw.insert(sec, (line, entries));
         }
+        // None: a finite-element rotor, whose [rotor] has tables and a path
         let model = match raw.get_mut("rotor") {
             Some((_, entries)) => self.rotor_model(entries)?,
-            None => ModelKind::Jeffcott,
+            None => Some(ModelKind::Jeffcott),
         };
+        let finite_element = match (model, rotor_item) {
+            (None, Some((item, line))) => {
+                if let Some((line, _)) = raw.get("initial") {
+                    return Err(ScenarioFileError::Inconsistent {
+                        origin: self.origin(),
+                        line: *line,
+                        message: "[initial] (x, z, vx, vz) is the initial state of a lumped \
+                                  rotor (jeffcott, cross_coupled): a finite_element rotor's is \
+                                  not given in the scenario"
+                            .to_owned(),
+                    });
+                }
+                Some(self.finite_element(item, line)?)
+            }
+            _ => None,
+        };
+        let model = model.unwrap_or(ModelKind::Jeffcott);
+        let fe_rotor = finite_element
+            .is_some()
+            .then(|| raw.remove("rotor"))
+            .flatten()
+            .map(|(line, _)| Section {
+                line,
+                keys: BTreeMap::new(),
+            });
         let mut take = |name: &'static str, keys: &[(&'static str, &'static str)]| {
             raw.remove(name)
                 .map(|(line, entries)| self.section(name, line, keys, entries))
                 .transpose()
         };
-        let rotor = take("rotor", rotor_keys(model))?.map(|(s, _)| s.canonical());
+        let rotor = match fe_rotor {
+            Some(s) => Some(s),
+            None => take("rotor", rotor_keys(model))?.map(|(s, _)| s.canonical()),
+        };
         let speed = take("speed", &SPEED_KEYS[1..])?;
         let sampling = take("sampling", &SAMPLING_KEYS)?.map(|(s, _)| s);
         let initial = take("initial", &INITIAL_KEYS)?.map(|(s, _)| s);
@@ -153,7 +188,9 @@ impl Parser<'_> {
                 needed_by: None,
             });
         };
-        self.check_rotor(&rotor, model)?;
+        if finite_element.is_none() {
+            self.check_rotor(&rotor, model)?;
+        }
         let speed = match speed {
             Some((s, kind)) => Some(self.speed_profile(&s, kind)?),
             None => None,
@@ -171,14 +208,18 @@ impl Parser<'_> {
             sampling,
             initial: initial.unwrap_or_default(),
             acquisition,
+            finite_element,
         })
     }
 
-    /// `rotor.model` (the string "jeffcott" or "cross_coupled"; default Jeffcott), taken out
-    /// of the section's entries.
-    fn rotor_model(&self, entries: &mut Vec<Entry<'_>>) -> Result<ModelKind, ScenarioFileError> {
+    /// `rotor.model` (the string "jeffcott", "cross_coupled" or "finite_element"; default
+    /// Jeffcott), taken out of the section's entries; `None` for "finite_element".
+    fn rotor_model(
+        &self,
+        entries: &mut Vec<Entry<'_>>,
+    ) -> Result<Option<ModelKind>, ScenarioFileError> {
         let Some(i) = entries.iter().position(|e| e.key == "model") else {
-            return Ok(ModelKind::Jeffcott);
+            return Ok(Some(ModelKind::Jeffcott));
         };
         let Entry {
             line,
@@ -187,17 +228,22 @@ impl Parser<'_> {
             ..
         } = entries.remove(i);
         match value {
-            Raw::String(s) => s.parse().map_err(|_| ScenarioFileError::UnknownModel {
-                origin: self.origin(),
-                line,
-                value: s,
-            }),
+            Raw::String(s) if s == FINITE_ELEMENT => Ok(None),
+            Raw::String(s) => s
+                .parse()
+                .map(Some)
+                .map_err(|_| ScenarioFileError::UnknownModel {
+                    origin: self.origin(),
+                    line,
+                    value: s,
+                }),
             Raw::Number(_) | Raw::Other => Err(ScenarioFileError::WrongType {
                 origin: self.origin(),
                 line,
                 key: "rotor.model".to_owned(),
                 value: written,
-                expected: "the string \"jeffcott\" or \"cross_coupled\"".to_owned(),
+                expected: "the string \"jeffcott\", \"cross_coupled\" or \"finite_element\""
+                    .to_owned(),
             }),
         }
     }
@@ -236,9 +282,16 @@ impl Parser<'_> {
                 };
                 let other_model = (name == "rotor")
                     .then(|| {
-                        ModelKind::ALL.into_iter().find(|m| {
-                            rotor_keys(*m) != keys && rotor_keys(*m).iter().any(|(k, _)| *k == key)
-                        })
+                        ModelKind::ALL
+                            .into_iter()
+                            .find(|m| {
+                                rotor_keys(*m) != keys
+                                    && rotor_keys(*m).iter().any(|(k, _)| *k == key)
+                            })
+                            .map(RotorModel::Lumped)
+                            .or(FINITE_ELEMENT_KEYS
+                                .contains(&key)
+                                .then_some(RotorModel::FiniteElement))
                     })
                     .flatten();
                 return Err(ScenarioFileError::UnknownKey {

@@ -23,6 +23,7 @@
 mod error;
 mod parameter;
 mod rotor;
+mod rows;
 
 pub use error::FiniteElementError;
 pub use parameter::{BearingCoefficient, FeParameter};
