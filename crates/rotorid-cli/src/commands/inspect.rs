@@ -226,52 +226,6 @@ fn extremes(data: &[f64]) -> (f64, f64, usize) {
     )
 }
 
-#[cfg(test)]
-mod tests {
-    use super::extremes;
-
-    /// Against the plain filter-and-fold, on lengths around the lane count, with NaN and
-    /// infinities in every position.
-    #[test]
-    fn extremes_are_those_of_a_plain_fold() {
-        let plain = |d: &[f64]| {
-            let (lo, hi) = d
-                .iter()
-                .filter(|v| !v.is_nan())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                    (lo.min(v), hi.max(v))
-                });
-            (lo, hi, d.iter().filter(|v| v.is_nan()).count())
-        };
-        let pool = [
-            1.5,
-            -2.0,
-            f64::NAN,
-            7.25,
-            f64::INFINITY,
-            -1e300,
-            f64::NEG_INFINITY,
-            3.0,
-        ];
-        for n in 0..40 {
-            for shift in 0..pool.len() {
-                let d: Vec<f64> = (0..n)
-                    .map(|i| pool[(i * 5 + shift) % pool.len()] * (i as f64 + 1.0))
-                    .collect();
-                let (a, b) = (extremes(&d), plain(&d));
-                assert_eq!(
-                    (a.0.to_bits(), a.1.to_bits(), a.2),
-                    (b.0.to_bits(), b.1.to_bits(), b.2),
-                    "{d:?}"
-                );
-            }
-        }
-        let nans = [f64::NAN; 11];
-        assert_eq!(extremes(&nans).2, 11);
-        assert!(extremes(&nans).0.is_infinite() && extremes(&nans).1.is_infinite());
-    }
-}
-
 /// `rotorid inspect fe.toml`: the finite-element rotor of a scenario, as its matrices file
 /// and `[rotor]` make it.
 fn finite_element(path: &str) -> anyhow::Result<()> {
@@ -329,4 +283,50 @@ fn finite_element(path: &str) -> anyhow::Result<()> {
     }
     out!("{out}")?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::extremes;
+
+    /// Against the plain filter-and-fold, on lengths around the lane count, with NaN and
+    /// infinities in every position.
+    #[test]
+    fn extremes_are_those_of_a_plain_fold() {
+        let plain = |d: &[f64]| {
+            let (lo, hi) = d
+                .iter()
+                .filter(|v| !v.is_nan())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(v), hi.max(v))
+                });
+            (lo, hi, d.iter().filter(|v| v.is_nan()).count())
+        };
+        let pool = [
+            1.5,
+            -2.0,
+            f64::NAN,
+            7.25,
+            f64::INFINITY,
+            -1e300,
+            f64::NEG_INFINITY,
+            3.0,
+        ];
+        for n in 0..40 {
+            for shift in 0..pool.len() {
+                let d: Vec<f64> = (0..n)
+                    .map(|i| pool[(i * 5 + shift) % pool.len()] * (i as f64 + 1.0))
+                    .collect();
+                let (a, b) = (extremes(&d), plain(&d));
+                assert_eq!(
+                    (a.0.to_bits(), a.1.to_bits(), a.2),
+                    (b.0.to_bits(), b.1.to_bits(), b.2),
+                    "{d:?}"
+                );
+            }
+        }
+        let nans = [f64::NAN; 11];
+        assert_eq!(extremes(&nans).2, 11);
+        assert!(extremes(&nans).0.is_infinite() && extremes(&nans).1.is_infinite());
+    }
 }
