@@ -381,7 +381,7 @@ fn symmetric(a: DMatrix<f64>) -> DMatrix<f64> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use std::sync::Arc;
 
     use super::super::parameter::BearingCoefficient;
