@@ -196,3 +196,93 @@ fn magnus_is_fourth_order_on_a_run_up_and_matches_extrapolated_newmark() {
     eprintln!("magnus dt = 1e-4 vs extrapolated newmark: {d:.2e}");
     assert!(d < 1e-7, "{d:e}");
 }
+
+#[test]
+fn bad_inputs_are_refused_naming_what_is_wrong() {
+    let rotor = ross_rotor();
+    let sys = FeSystem::full(&rotor);
+    let sampling = Sampling::new(1e-4, 0.01).unwrap();
+    let constant = SpeedProfile::Constant {
+        omega: 100.0,
+        phi0: 0.0,
+    };
+    let ramp = SpeedProfile::Ramp {
+        omega0: 0.0,
+        accel: 10.0,
+        phi0: 0.0,
+    };
+    let e = simulate_fe(&sys, &ramp, &sampling, None, None, FeMethod::Exact).unwrap_err();
+    assert!(
+        e.to_string().starts_with("accel = 10 is out of range"),
+        "{e}"
+    );
+    let bad: Vec<_> = vec!["11.x".parse().unwrap()];
+    let e = simulate_fe(
+        &sys,
+        &constant,
+        &sampling,
+        None,
+        Some(&bad),
+        FeMethod::Magnus,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("11.x"), "{e}");
+    let short = FeInitialState::rest(40);
+    let e = simulate_fe(
+        &sys,
+        &constant,
+        &sampling,
+        Some(&short),
+        None,
+        FeMethod::Newmark,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("q0 has 40 entries") && e.contains("(44)"), "{e}");
+    let mut nan = FeInitialState::rest(44);
+    nan.v[13] = f64::NAN;
+    let e = simulate_fe(
+        &sys,
+        &constant,
+        &sampling,
+        Some(&nan),
+        None,
+        FeMethod::Exact,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("v0 at 3.y = NaN"), "{e}");
+    let e = "rk4".parse::<FeMethod>().unwrap_err().to_string();
+    assert!(e.contains("\"rk4\""), "{e}");
+    for m in [FeMethod::Newmark, FeMethod::Exact, FeMethod::Magnus] {
+        assert_eq!(m.to_string().parse::<FeMethod>().unwrap(), m);
+    }
+}
+
+#[test]
+fn response_table_names_its_columns_as_the_issue_does() {
+    let rotor = ross_rotor();
+    let sys = RitzBasis::new(&rotor, 4).unwrap().system(&rotor);
+    let speed = SpeedProfile::Constant {
+        omega: 100.0,
+        phi0: 0.5,
+    };
+    let r = simulate_fe(
+        &sys,
+        &speed,
+        &Sampling::new(1e-3, 0.01).unwrap(),
+        None,
+        Some(&probes()),
+        FeMethod::Exact,
+    )
+    .unwrap();
+    assert_eq!(
+        r.header().join(","),
+        "t,0.x,0.y,10.x,10.y,phi,phi_dot,phi_ddot"
+    );
+    assert_eq!(r.len(), 11);
+    assert_eq!(r.t[7], 7.0 * 1e-3);
+    assert_eq!(r.phi[0], 0.5);
+    assert_eq!(r.q[0][0], 0.0);
+}
