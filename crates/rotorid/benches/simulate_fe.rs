@@ -25,7 +25,8 @@ fn benches(c: &mut Criterion) {
     let full = FeSystem::full(&rotor);
     let reduced = RitzBasis::new(&rotor, 8)
         .expect("valid basis")
-        .system(&rotor);
+        .system(&rotor)
+        .unwrap();
     let sampling = Sampling::new(1e-4, 1.0).expect("valid");
     let constant = SpeedProfile::Constant {
         omega: 300.0,

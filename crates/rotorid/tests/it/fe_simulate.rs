@@ -95,7 +95,7 @@ fn exact_and_magnus_agree_at_constant_speed_including_the_transient() {
 #[test]
 fn newmark_converges_at_second_order_to_the_exact_solution() {
     let rotor = ross_rotor();
-    let sys = RitzBasis::new(&rotor, 8).unwrap().system(&rotor);
+    let sys = RitzBasis::new(&rotor, 8).unwrap().system(&rotor).unwrap();
     let speed = SpeedProfile::Constant {
         omega: 300.0,
         phi0: 0.0,
@@ -146,7 +146,7 @@ fn newmark_converges_at_second_order_to_the_exact_solution() {
 #[test]
 fn magnus_is_fourth_order_on_a_run_up_and_matches_extrapolated_newmark() {
     let rotor = ross_rotor();
-    let sys = RitzBasis::new(&rotor, 8).unwrap().system(&rotor);
+    let sys = RitzBasis::new(&rotor, 8).unwrap().system(&rotor).unwrap();
     let speed = SpeedProfile::Ramp {
         omega0: 250.0,
         accel: 400.0,
@@ -263,7 +263,7 @@ fn bad_inputs_are_refused_naming_what_is_wrong() {
 #[test]
 fn response_table_names_its_columns_as_the_issue_does() {
     let rotor = ross_rotor();
-    let sys = RitzBasis::new(&rotor, 4).unwrap().system(&rotor);
+    let sys = RitzBasis::new(&rotor, 4).unwrap().system(&rotor).unwrap();
     let speed = SpeedProfile::Constant {
         omega: 100.0,
         phi0: 0.5,

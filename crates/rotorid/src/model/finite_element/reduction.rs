@@ -229,8 +229,9 @@ impl RitzBasis {
         &self.frequencies
     }
 
-    /// The reduced system of `rotor` in this basis ([`FeSystem::reduced`]).
-    pub fn system(&self, rotor: &FiniteElementRotor) -> FeSystem {
+    /// The reduced system of `rotor` in this basis ([`FeSystem::reduced`]); `rotor` must
+    /// have the degrees of freedom the basis was made for.
+    pub fn system(&self, rotor: &FiniteElementRotor) -> Result<FeSystem, FiniteElementError> {
         FeSystem::reduced(rotor, &self.t)
     }
 }
@@ -273,6 +274,15 @@ mod tests {
         for (a, e) in b.frequencies().iter().zip(&ev).take(2) {
             assert!((a - e).abs() < 1e-9 * e, "{a} vs {e}");
         }
+        // a basis of the wrong size or with dependent columns is refused, by name
+        let t = b.matrix();
+        let dependent = DMatrix::from_columns(&[t.column(0).into_owned(), t.column(0) * 2.0]);
+        let e = FeSystem::reduced(&r, &dependent).unwrap_err().to_string();
+        assert!(e.contains("dependent columns"), "{e}");
+        let e = FeSystem::reduced(&r, &DMatrix::identity(7, 3))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("7 x 3") && e.contains("(8)"), "{e}");
         assert!(matches!(
             RitzBasis::new(&r, 9),
             Err(FiniteElementError::ModeCount { modes: 9, n: 8 })

@@ -114,18 +114,39 @@ impl FeSystem {
         s
     }
 
-    /// `rotor` in the coordinates q_s of `basis` (q = T q_s, T n x r): every matrix
-    /// projected, T^T X T, and every location vector, T^T b; the bearings and unbalances
-    /// then enter exactly as in the full model.
-    pub fn reduced(rotor: &FiniteElementRotor, basis: &DMatrix<f64>) -> Self {
+    /// `rotor` in the coordinates q_s of `basis` (q = T q_s, T n x r with independent
+    /// columns): every matrix projected, T^T X T, and every location vector, T^T b; the
+    /// bearings and unbalances then enter exactly as in the full model. Refused when T
+    /// does not have n rows or T^T M T is not positive definite (dependent columns).
+    pub fn reduced(
+        rotor: &FiniteElementRotor,
+        basis: &DMatrix<f64>,
+    ) -> Result<Self, FiniteElementError> {
         let full = Self::full(rotor);
         let t = basis;
+        if t.nrows() != full.len() || t.ncols() == 0 {
+            return Err(FiniteElementError::Inconsistent {
+                what: format!(
+                    "the basis is {} x {}: it must have one row per degree of freedom ({}) \
+                     and at least one column",
+                    t.nrows(),
+                    t.ncols(),
+                    full.len()
+                ),
+            });
+        }
         let tt = t.transpose();
         let proj = |a: &DMatrix<f64>| &tt * a * t;
         let projv = |[x, y]: &[DVector<f64>; 2]| [&tt * x, &tt * y];
         let m = symmetric(proj(&full.m));
         let tm = &tt * &full.m;
-        let projector = m.clone().lu().solve(&tm).unwrap_or(tm);
+        // (T^T M T)^-1 T^T M (T^T M T = I for an M-orthonormal basis)
+        let projector = m.clone().cholesky().map(|c| c.solve(&tm)).ok_or_else(|| {
+            FiniteElementError::Inconsistent {
+                what: "the basis has dependent columns: T^T M T is not positive definite"
+                    .to_owned(),
+            }
+        })?;
         let mut s = Self {
             dofs: full.dofs.clone(),
             basis: Some(t.clone()),
@@ -144,7 +165,7 @@ impl FeSystem {
             load: DVector::zeros(0),
         };
         s.assemble();
-        s
+        Ok(s)
     }
 
     /// Take the bearings' and unbalances' values of `rotor` (same count and nodes as the
