@@ -34,6 +34,19 @@ fn closed_form_steady_state_equals_ross_unbalance_response() {
     }
 }
 
+/// Every k-th sample of `r` (a finer record on the coarser grid).
+fn every(r: &FeResponse, k: usize) -> FeResponse {
+    let pick = |v: &Vec<f64>| v.iter().step_by(k).copied().collect();
+    FeResponse {
+        t: pick(&r.t),
+        q: r.q.iter().map(pick).collect(),
+        phi: pick(&r.phi),
+        phi_dot: pick(&r.phi_dot),
+        phi_ddot: pick(&r.phi_ddot),
+        dofs: r.dofs.clone(),
+    }
+}
+
 /// The response sampled by an integrator, every degree of freedom.
 fn all_dofs(r: &FeResponse) -> usize {
     r.dofs.len()
@@ -122,19 +135,7 @@ fn newmark_converges_at_second_order_to_the_exact_solution() {
             FeMethod::Newmark,
         )
         .unwrap();
-        let every = FeResponse {
-            t: nm.t.iter().step_by(k).copied().collect(),
-            q: nm
-                .q
-                .iter()
-                .map(|c| c.iter().step_by(k).copied().collect())
-                .collect(),
-            phi: nm.phi.iter().step_by(k).copied().collect(),
-            phi_dot: nm.phi_dot.iter().step_by(k).copied().collect(),
-            phi_ddot: nm.phi_ddot.iter().step_by(k).copied().collect(),
-            dofs: nm.dofs.clone(),
-        };
-        errs.push(max_rel(&exact, &every));
+        errs.push(max_rel(&exact, &every(&nm, k)));
     }
     eprintln!("newmark errors at dt = 1e-4, 5e-5, 2.5e-5: {errs:?}");
     for p in errs.windows(2) {
@@ -164,27 +165,16 @@ fn magnus_is_fourth_order_on_a_run_up_and_matches_extrapolated_newmark() {
         )
         .unwrap()
     };
-    let sub = |r: &FeResponse, k: usize| FeResponse {
-        t: r.t.iter().step_by(k).copied().collect(),
-        q: r.q
-            .iter()
-            .map(|c| c.iter().step_by(k).copied().collect())
-            .collect(),
-        phi: r.phi.iter().step_by(k).copied().collect(),
-        phi_dot: r.phi_dot.iter().step_by(k).copied().collect(),
-        phi_ddot: r.phi_ddot.iter().step_by(k).copied().collect(),
-        dofs: r.dofs.clone(),
-    };
     let fine = run(2.5e-5, FeMethod::Magnus);
-    let e4 = max_rel(&sub(&fine, 16), &run(4e-4, FeMethod::Magnus));
-    let e2 = max_rel(&sub(&fine, 8), &run(2e-4, FeMethod::Magnus));
-    let e1 = max_rel(&sub(&fine, 4), &run(1e-4, FeMethod::Magnus));
+    let e4 = max_rel(&every(&fine, 16), &run(4e-4, FeMethod::Magnus));
+    let e2 = max_rel(&every(&fine, 8), &run(2e-4, FeMethod::Magnus));
+    let e1 = max_rel(&every(&fine, 4), &run(1e-4, FeMethod::Magnus));
     eprintln!("magnus errors at dt = 4e-4, 2e-4, 1e-4: {e4:.2e} {e2:.2e} {e1:.2e}");
     assert!(e4 / e2 > 12.0 && e2 / e1 > 12.0, "{e4:e} {e2:e} {e1:e}");
     assert!(e1 < 1e-8, "{e1:e}");
     // independent: Newmark at dt/4 and dt/8 extrapolated (Richardson, error O(dt^4))
-    let n4 = sub(&run(2.5e-5, FeMethod::Newmark), 4);
-    let n8 = sub(&run(1.25e-5, FeMethod::Newmark), 8);
+    let n4 = every(&run(2.5e-5, FeMethod::Newmark), 4);
+    let n8 = every(&run(1.25e-5, FeMethod::Newmark), 8);
     let mut rich = n8.clone();
     for (c, (a, b)) in rich.q.iter_mut().zip(n4.q.iter().zip(&n8.q)) {
         for (x, (p, q)) in c.iter_mut().zip(a.iter().zip(b)) {
