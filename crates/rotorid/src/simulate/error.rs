@@ -47,6 +47,21 @@ pub enum SimulateError {
         /// Index of the first offending sample.
         index: usize,
     },
+    /// A finite-element rotor or system that cannot be simulated as given.
+    #[error(transparent)]
+    FiniteElement(#[from] crate::model::finite_element::FiniteElementError),
+    /// A finite-element initial state whose length is not the number of degrees of freedom.
+    #[error(
+        "initial {what} has {len} entries: must have one per degree of freedom of the rotor ({n})"
+    )]
+    InitialStateLength {
+        /// `q0` (displacements, m or rad) or `v0` (velocities, m/s or rad/s).
+        what: &'static str,
+        /// Its length.
+        len: usize,
+        /// The rotor's number of degrees of freedom.
+        n: usize,
+    },
     /// A method name that is neither `newmark` nor `exact`.
     #[error("unknown simulation method {name:?}: expected \"newmark\" or \"exact\"")]
     UnknownMethod {

@@ -20,12 +20,16 @@
 //! Every integrator produces sample i at t_i = i * dt exactly (computed so, never by
 //! accumulating dt), starting from t_0 = 0 with the scenario's initial state.
 //!
+//! Finite-element rotors (issue 27) have their own integrators and response table in
+//! [`finite_element`] (the Jeffcott and cross-coupled path above is unchanged).
+//!
 //! Also here: [`add_noise`] (white Gaussian measurement noise at a given SNR, reproducible
 //! from a seed) and [`steady_state()`] (the closed-form constant-speed steady state, the
 //! oracle the tests check the integrators against).
 
 mod error;
 mod exact_constant;
+pub mod finite_element;
 mod newmark;
 mod noise;
 mod phase;

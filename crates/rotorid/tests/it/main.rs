@@ -2,6 +2,7 @@
 //! `cargo test -p rotorid --test it`).
 
 mod cross_common;
+mod fe_common;
 mod identify_common;
 
 mod acquisition;
@@ -16,6 +17,9 @@ mod cross_modulating;
 mod cross_pipeline;
 mod cross_reference;
 mod defects;
+mod fe_cross;
+mod fe_reduction;
+mod fe_simulate;
 mod identify_accuracy;
 mod identify_conditioning;
 mod identify_convergence;

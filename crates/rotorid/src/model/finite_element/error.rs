@@ -121,4 +121,42 @@ pub enum FiniteElementError {
         /// What the rotor has, in words.
         allowed: String,
     },
+    /// A degree of freedom asked for that the rotor does not have.
+    #[error("degree of freedom {name} is not one of the rotor's {n} (see its dofs)")]
+    UnknownDof {
+        /// The name asked for.
+        name: String,
+        /// How many the rotor has.
+        n: usize,
+    },
+    /// Parts that do not fit together (e.g. a system updated with a rotor of other
+    /// bearings).
+    #[error("inconsistent finite-element model: {what}")]
+    Inconsistent {
+        /// What does not fit, in words.
+        what: String,
+    },
+    /// The steady-state system K0 - w^2 M + i w (C0 + w G) is singular at this speed.
+    #[error(
+        "the steady-state 1X response at w = {omega} rad/s does not exist: K0 - w^2 M + i w \
+         (C0 + w G) is singular there (an undamped rotor at a critical speed)"
+    )]
+    SingularSteadyState {
+        /// The speed w \[rad/s\].
+        omega: f64,
+    },
+    /// The stiffness K + K_b is singular: no static shape (the rotor is not held by its
+    /// bearings).
+    #[error("K + K_b is singular: the static shapes of the reduction need a rotor held by its bearings (every rigid-body motion restrained)")]
+    SingularStiffness,
+    /// A reduction asked for more modes than the rotor has, or for none.
+    #[error(
+        "modes = {modes} is out of range: must be 1 ..= {n} (the number of degrees of freedom)"
+    )]
+    ModeCount {
+        /// Asked for.
+        modes: usize,
+        /// Degrees of freedom.
+        n: usize,
+    },
 }

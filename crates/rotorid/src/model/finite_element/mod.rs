@@ -18,13 +18,20 @@
 //!
 //! This module holds the vocabulary every part of the finite-element work shares: the
 //! degrees of freedom, the matrices, the bearings, the unbalances and the parameters that
-//! name them (`bearing<i>.kxx`, `unbalance<j>.mud`, ...). Every quantity is SI.
+//! name them (`bearing<i>.kxx`, `unbalance<j>.mud`, ...); the assembled equation of motion
+//! in full or reduced coordinates with its derivatives and closed-form steady state
+//! ([`FeSystem`]); and the reduction ([`RitzBasis`]). Every quantity is SI.
 
 mod error;
 mod parameter;
+mod reduction;
 mod rotor;
 mod rows;
+mod system;
 
 pub use error::FiniteElementError;
 pub use parameter::{BearingCoefficient, FeParameter};
+pub use reduction::RitzBasis;
 pub use rotor::{Bearing, Dof, DofKind, FeMatrices, FeUnbalance, FiniteElementRotor};
+pub(crate) use system::force_of;
+pub use system::{FeDerivative, FeSystem};
