@@ -10,6 +10,7 @@ mod daqmx;
 mod dashboard;
 mod dashboard_browser;
 mod demo;
+mod finite_element;
 mod fleet;
 mod formats;
 mod golden;

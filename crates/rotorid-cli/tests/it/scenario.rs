@@ -358,14 +358,13 @@ fn a_finite_element_scenario_loads_with_its_matrices_and_simulate_names_the_mode
         (u[1] - 1.0e-5).abs() < 1e-16 && (u[2] - 45.0).abs() < 1e-9,
         "{u:?}"
     );
-    // simulate does not take a finite-element rotor (yet): it says so, naming the model
+    // simulate takes the rotor (tests/it/finite_element.rs) and names what it lacks here
     let out = simulate(&toml, &[]);
     let err = String::from_utf8(out.stderr).unwrap();
     assert!(!out.status.success());
     assert!(
-        err.contains(&format!(
-            "{toml}:1: rotor.model = \"finite_element\": simulate does not take a finite-element rotor"
-        )),
+        err.contains(&format!("{toml}: missing section [speed]"))
+            && err.contains("simulate needs it"),
         "{err}"
     );
 }

@@ -413,6 +413,35 @@ impl ScenarioSpec {
         Ok(sc)
     }
 
+    /// The speed profile and sampling grid of a finite-element scenario's simulation
+    /// (`ov`'s dt and duration take precedence; its initial state is refused: a
+    /// finite-element simulation starts at rest).
+    pub fn fe_simulation(
+        &self,
+        ov: &SimulationOverrides,
+    ) -> Result<(SpeedProfile, Sampling), ScenarioFileError> {
+        if self.finite_element.is_none() {
+            return Err(ScenarioFileError::Inconsistent {
+                origin: self.origin.clone(),
+                line: self.rotor.line,
+                message: format!(
+                    "rotor.model is \"{}\": a finite-element simulation needs rotor.model = \
+                     \"finite_element\"",
+                    self.model.name()
+                ),
+            });
+        }
+        let speed = self
+            .speed
+            .ok_or_else(|| ScenarioFileError::MissingSection {
+                origin: self.origin.clone(),
+                section: "speed".to_owned(),
+                contents: SPEED_CONTENTS.to_owned(),
+                needed_by: Some("simulate".to_owned()),
+            })?;
+        Ok((speed, self.sampling_with(ov)?))
+    }
+
     /// What the identification pipeline knows from this scenario: the known a and
     /// unbalance, its m, c, k (those stated) as nominal values and as the truth, and, when
     /// the scenario describes a whole simulation, its initial state as the true state at

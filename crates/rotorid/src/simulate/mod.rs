@@ -46,7 +46,7 @@ use crate::model::{Scenario, SpeedState};
 pub use error::SimulateError;
 pub use exact_constant::ExactConstant;
 pub use newmark::Newmark;
-pub use noise::{add_noise, NoiseLevel};
+pub use noise::{add_noise, add_noise_to, NoiseLevel};
 pub use reference_dopri8::{DoPri8Reference, DEFAULT_TOLERANCE};
 pub use steady_state::{steady_state, SteadyState};
 

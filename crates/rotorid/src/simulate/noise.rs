@@ -54,28 +54,46 @@ pub fn add_noise(
     snr_db: f64,
     seed: u64,
 ) -> Result<NoiseLevel, SimulateError> {
+    let [sigma_x, sigma_z] = add_noise_to(
+        &mut [("x", &mut resp.x[..]), ("z", &mut resp.z[..])],
+        snr_db,
+        seed,
+    )?[..] else {
+        unreachable!("one sigma per channel")
+    };
+    Ok(NoiseLevel { sigma_x, sigma_z })
+}
+
+/// Add white Gaussian noise to each of `channels` (name for errors, samples) at `snr_db`
+/// \[dB\] of that channel's RMS, reproducibly from `seed`: the draws go to the channels
+/// in the order given, each channel's in sample order (the module's contract; for x then
+/// z it is [`add_noise`]). Returns the sigma of each channel, in its unit.
+pub fn add_noise_to(
+    channels: &mut [(&'static str, &mut [f64])],
+    snr_db: f64,
+    seed: u64,
+) -> Result<Vec<f64>, SimulateError> {
     check("snr_db", snr_db, "finite (dB)", |_| true)?;
     let ratio = 10f64.powf(-snr_db / 20.0);
-    let sigma_x = rms("x", &resp.x)? * ratio;
-    let sigma_z = rms("z", &resp.z)? * ratio;
-    for (field, s) in [("sigma_x", sigma_x), ("sigma_z", sigma_z)] {
-        check(
-            field,
-            s,
-            "finite (m): snr_db is too low for this signal",
-            |_| true,
-        )?;
+    let mut sigmas = Vec::with_capacity(channels.len());
+    for (name, c) in channels.iter() {
+        let s = rms(name, c)? * ratio;
+        let (field, allowed) = match *name {
+            "x" => ("sigma_x", "finite (m): snr_db is too low for this signal"),
+            "z" => ("sigma_z", "finite (m): snr_db is too low for this signal"),
+            _ => ("sigma", "finite: snr_db is too low for this signal"),
+        };
+        check(field, s, allowed, |_| true)?;
+        sigmas.push(s);
     }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    for x in resp.x.iter_mut() {
-        let n: f64 = rng.sample(StandardNormal);
-        *x += sigma_x * n;
+    for ((_, c), &s) in channels.iter_mut().zip(&sigmas) {
+        for v in c.iter_mut() {
+            let n: f64 = rng.sample(StandardNormal);
+            *v += s * n;
+        }
     }
-    for z in resp.z.iter_mut() {
-        let n: f64 = rng.sample(StandardNormal);
-        *z += sigma_z * n;
-    }
-    Ok(NoiseLevel { sigma_x, sigma_z })
+    Ok(sigmas)
 }
 
 #[cfg(test)]

@@ -1,0 +1,167 @@
+//! `rotorid simulate` of a finite-element scenario (issue 27): the matrices file beside
+//! the scenario, the response at every degree of freedom under `<node>.<dof>` columns,
+//! checked end to end against an independent path: a one-node rotor is the cross-coupled
+//! 2-DOF model under x = x, y = -z (docs/finite_element.md section 2), which `rotorid
+//! simulate` integrates with its own simulators (exact discretisation, DoPri8 on a ramp).
+
+use rotorid_io::FeMatricesFile;
+
+use crate::common::{rotorid, simulate};
+
+const A: f64 = 2.871;
+const M: f64 = 14.29;
+
+/// The one-node rotor's matrices (dofs 0.x, 0.y) in `dir/m.npz`.
+fn matrices(dir: &std::path::Path) {
+    rotorid_io::fe_matrices::write(
+        dir.join("m.npz"),
+        &FeMatricesFile {
+            file: String::new(),
+            dofs: vec!["0.x".into(), "0.y".into()],
+            m: vec![M, 0.0, 0.0, M],
+            k: vec![0.0; 4],
+            g: vec![0.0, A, -A, 0.0],
+            c: None,
+            ka: Some(vec![0.0, A, 0.0, 0.0]),
+        },
+    )
+    .unwrap();
+}
+
+/// The [speed] and [sampling] sections.
+fn speed(ramp: bool) -> &'static str {
+    if ramp {
+        "[speed]\nkind = \"ramp\"\nrpm0 = 600.0\naccel = 40.0\n\n[sampling]\ndt = 1e-4\nduration = 0.3\n"
+    } else {
+        "[speed]\nkind = \"constant\"\nrpm = 1200.0\n\n[sampling]\ndt = 1e-4\nduration = 0.3\n"
+    }
+}
+
+/// The same rotor as a finite-element scenario and as a cross-coupled one.
+fn scenarios(dir: &std::path::Path, ramp: bool) -> (String, String) {
+    matrices(dir);
+    let fe = dir.join(format!("fe{ramp}.toml"));
+    std::fs::write(
+        &fe,
+        format!(
+            "[rotor]\nmodel = \"finite_element\"\nmatrices = \"m.npz\"\n\n[[rotor.bearing]]\n\
+             node = 0\nkxx = 1.195e6\nkxy = 3.0e4\nkyx = -3.0e4\nkyy = 1.4e6\ncxx = 200.0\n\
+             cxy = -20.0\ncyx = -20.0\ncyy = 200.0\n\n[[rotor.unbalance]]\nnode = 0\n\
+             m_u = 1e-4\nd = 0.15\nalpha_deg = -45.0\n\n{}",
+            speed(ramp)
+        ),
+    )
+    .unwrap();
+    let cross = dir.join(format!("cross{ramp}.toml"));
+    std::fs::write(
+        &cross,
+        format!(
+            "[rotor]\nmodel = \"cross_coupled\"\nm = {M}\na = {A}\nkxx = 1.195e6\n\
+             kxz = -3.0e4\nkzx = 3.0e4\nkzz = 1.4e6\ncxx = 200.0\ncxz = 20.0\nczx = 20.0\n\
+             czz = 200.0\nm_u = 1e-4\nd = 0.15\nalpha_deg = 45.0\n\n{}",
+            speed(ramp)
+        ),
+    )
+    .unwrap();
+    (
+        fe.to_str().unwrap().to_owned(),
+        cross.to_str().unwrap().to_owned(),
+    )
+}
+
+fn columns(csv: &str) -> (String, Vec<Vec<f64>>) {
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap().to_owned();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn a_one_node_rotor_simulates_as_the_cross_coupled_model() {
+    let dir = tempfile::tempdir().unwrap();
+    for ramp in [false, true] {
+        let (fe, cross) = scenarios(dir.path(), ramp);
+        let (header, f) = columns(&simulate(&["--scenario", &fe]));
+        assert_eq!(header, "t,0.x,0.y,phi,phi_dot,phi_ddot");
+        let (_, c) = columns(&simulate(&["--scenario", &cross]));
+        assert_eq!(f.len(), 3001);
+        let amplitude = c
+            .iter()
+            .fold(0.0f64, |a, r| a.max(r[1].abs()).max(r[2].abs()));
+        let mut worst = 0.0f64;
+        for (a, b) in f.iter().zip(&c) {
+            assert_eq!(a[0], b[0]);
+            // x = x, y = -z; the speed columns equal
+            worst = worst.max((a[1] - b[1]).abs()).max((a[2] + b[2]).abs());
+            for k in 3..6 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-12 * b[k].abs().max(1.0),
+                    "{a:?} {b:?}"
+                );
+            }
+        }
+        println!(
+            "ramp {ramp}: worst difference {:.1e} of the amplitude",
+            worst / amplitude
+        );
+        assert!(
+            worst < 1e-9 * amplitude,
+            "ramp {ramp}: {worst:e} of {amplitude:e}"
+        );
+    }
+}
+
+#[test]
+fn noise_is_reproducible_and_two_dof_options_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let (fe, _) = scenarios(dir.path(), false);
+    let a = simulate(&["--scenario", &fe, "--snr-db", "40", "--seed", "3"]);
+    assert_eq!(
+        a,
+        simulate(&["--scenario", &fe, "--snr-db", "40", "--seed", "3"])
+    );
+    assert_ne!(
+        a,
+        simulate(&["--scenario", &fe, "--snr-db", "40", "--seed", "4"])
+    );
+    let (_, clean) = columns(&simulate(&["--scenario", &fe]));
+    let (_, noisy) = columns(&a);
+    // sigma = RMS * 10^(-40/20): the residual's RMS within 10 % of it on 3001 samples
+    for col in [1, 2] {
+        let rms = |v: &dyn Fn(&Vec<f64>) -> f64| {
+            (clean.iter().map(v).map(|x| x * x).sum::<f64>() / clean.len() as f64).sqrt()
+        };
+        let signal = rms(&|r| r[col]);
+        let residual = (noisy
+            .iter()
+            .zip(&clean)
+            .map(|(n, c)| (n[col] - c[col]).powi(2))
+            .sum::<f64>()
+            / clean.len() as f64)
+            .sqrt();
+        assert!(
+            (residual / (0.01 * signal) - 1.0).abs() < 0.1,
+            "{residual:e} {signal:e}"
+        );
+    }
+    let out = rotorid()
+        .args([
+            "simulate",
+            "--scenario",
+            &fe,
+            "--initial-x",
+            "1e-5",
+            "--out",
+            "-",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("--initial-x") && e.contains("finite-element"),
+        "{e}"
+    );
+}
