@@ -58,6 +58,7 @@
 //! `crb` (bound, model response), `result` (reported structures, warnings).
 
 mod crb;
+pub mod finite_element;
 mod discretisation;
 mod error;
 mod exact_step;

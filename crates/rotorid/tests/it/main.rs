@@ -19,6 +19,7 @@ mod cross_reference;
 mod defects;
 mod fe_cross;
 mod fe_reduction;
+mod fe_refine;
 mod fe_simulate;
 mod identify_accuracy;
 mod identify_conditioning;
