@@ -392,6 +392,12 @@ impl<'a> Fit<'a> {
             let small = result::inverse(&a).is_some_and(|cov| {
                 (0..step.len()).all(|i| step[i].abs() <= tol * cov[(i, i)].max(0.0).sqrt())
             });
+            if small && lambda <= 1e-2 {
+                // the Gauss-Newton step is below the tolerance: taking it would not move
+                // any estimate by more than `tol` standard errors
+                converged = true;
+                break;
+            }
             let (rotor, x0) = match self.apply(&step) {
                 Some(v) => v,
                 None => {
@@ -407,9 +413,6 @@ impl<'a> Fit<'a> {
             let basis = RitzBasis::new(&rotor, p.modes())?;
             let trial = p.evaluate(&rotor, basis.matrix(), &x0, at, true)?;
             let new_cost = trial.cost(self.y, k, &self.weights);
-            if std::env::var_os("ROTORID_FE_TRACE").is_some() {
-                eprintln!("k {k} n {} trial {trials} lambda {lambda:.1e} cost {cost:.6e} -> {new_cost:.6e} small {small} step {:?}", at.1, step.as_slice());
-            }
             if new_cost <= cost {
                 self.rotor = rotor;
                 self.x0 = x0;
@@ -417,10 +420,6 @@ impl<'a> Fit<'a> {
                 eval = trial;
                 cost = new_cost;
                 lambda = (lambda / 10.0).max(1e-9);
-                if small && lambda <= 1e-2 {
-                    converged = true;
-                    break;
-                }
             } else {
                 lambda *= 10.0;
                 if small || lambda > 1e12 {
