@@ -4,64 +4,13 @@
 //! (bearing coefficients 30-70 % off, unbalance angles 40 deg off). Figures printed with
 //! `cargo test -p rotorid --test it fe_refine -- --nocapture`.
 
-use rotorid::model::finite_element::{FeParameter, FeSystem, FiniteElementRotor};
-use rotorid::model::{Sampling, SpeedProfile};
+use rotorid::model::finite_element::{FeParameter, FiniteElementRotor};
+use rotorid::model::SpeedProfile;
 use rotorid::refine::finite_element::{
     crb_fe, refine_fe, FeData, FeInitial, FeRefineOptions, FeRefined,
 };
-use rotorid::simulate::add_noise_to;
-use rotorid::simulate::finite_element::{simulate_fe, FeMethod, FeResponse};
 
-use crate::fe_common::{probes, ross_rotor};
-
-/// The truth's response at the probes from rest, with noise at `snr_db` (seed).
-pub fn record(
-    rotor: &FiniteElementRotor,
-    speed: &SpeedProfile,
-    duration: f64,
-    snr_db: f64,
-    seed: u64,
-) -> (FeResponse, Vec<f64>) {
-    let method = if speed.is_constant() {
-        FeMethod::Exact
-    } else {
-        FeMethod::Magnus
-    };
-    let mut r = simulate_fe(
-        &FeSystem::full(rotor),
-        speed,
-        &Sampling::new(1e-4, duration).unwrap(),
-        None,
-        Some(&probes()),
-        method,
-    )
-    .unwrap();
-    let names = ["0.x", "0.y", "10.x", "10.y"];
-    let mut chans: Vec<(&'static str, &mut [f64])> = names
-        .iter()
-        .zip(r.q.iter_mut())
-        .map(|(n, c)| (*n, c.as_mut_slice()))
-        .collect();
-    let sigma = add_noise_to(&mut chans, snr_db, seed).unwrap();
-    (r, sigma)
-}
-
-/// An engineering guess: direct coefficients 30-70 % off, angles 40 deg off, mud 50 % off.
-pub fn guess(truth: &FiniteElementRotor) -> FiniteElementRotor {
-    let mut g = truth.clone();
-    let f = [1.5, 0.6, 1.4, 0.7];
-    for (i, b) in g.bearings.iter_mut().enumerate() {
-        b.kxx *= f[i % 4];
-        b.kyy *= f[(i + 1) % 4];
-        b.cxx *= f[(i + 2) % 4];
-        b.cyy *= f[(i + 3) % 4];
-    }
-    for (j, u) in g.unbalances.iter_mut().enumerate() {
-        u.mud *= if j == 0 { 1.5 } else { 0.6 };
-        u.alpha += 40f64.to_radians() * if j == 0 { 1.0 } else { -1.0 };
-    }
-    g
-}
+use crate::fe_common::{guess, record, ross_rotor};
 
 fn report(fit: &FeRefined, truth: &FiniteElementRotor) -> f64 {
     let mut worst: f64 = 0.0;
@@ -131,6 +80,32 @@ fn fe_refine_recovers_bearings_and_unbalances_at_constant_speed_from_rest() {
     let t0 = std::time::Instant::now();
     let mut fit = refine_fe(&data, &start, &options).unwrap();
     eprintln!("constant 200 rad/s 1 s from rest, 40 dB, fit in {:?}", t0.elapsed());
+    let crb = crb_fe(&data, &truth, &options.unknowns, FeInitial::Rest, &sigma, 8).unwrap();
+    fit.attach_crb(&crb);
+    let worst = report(&fit, &truth);
+    assert!(fit.converged && fit.identifiable, "{:?}", fit.warnings);
+    assert!(worst < 4.5, "{worst}");
+}
+
+#[test]
+fn fe_refine_fast_run_up_of_the_benchmark() {
+    // the benchmark's case (benches/refine_fe.rs): 0 -> 450 rad/s in 1 s
+    let truth = ross_rotor();
+    let speed = SpeedProfile::Ramp {
+        omega0: 0.0,
+        accel: 450.0,
+        phi0: 0.0,
+    };
+    let (rec, sigma) = record(&truth, &speed, 1.0, 40.0, 3);
+    let data = FeData {
+        response: &rec,
+        speed,
+    };
+    let mut options = FeRefineOptions::new(&truth);
+    options.initial = FeInitial::Rest;
+    let t0 = std::time::Instant::now();
+    let mut fit = refine_fe(&data, &guess(&truth), &options).unwrap();
+    eprintln!("run-up 0 -> 450 rad/s in 1 s, 40 dB, fit in {:?}", t0.elapsed());
     let crb = crb_fe(&data, &truth, &options.unknowns, FeInitial::Rest, &sigma, 8).unwrap();
     fit.attach_crb(&crb);
     let worst = report(&fit, &truth);

@@ -38,6 +38,8 @@ pub(crate) struct Evaluation {
     pub(crate) jac: Vec<Vec<Vec<f64>>>,
     /// The decimation k.
     pub(crate) k: usize,
+    /// units\[j\] = the responses to U_j = 1 and U_j = i (channels x samples).
+    pub(crate) units: Vec<Vec<Vec<Vec<f64>>>>,
 }
 
 impl FeProblem {
@@ -258,7 +260,7 @@ impl FeProblem {
             }
             jac.extend(free);
         }
-        Ok(Evaluation { y, jac, k })
+        Ok(Evaluation { y, jac, k, units })
     }
 }
 
@@ -322,6 +324,98 @@ impl Evaluation {
                     .sum::<f64>()
             })
             .sum()
+    }
+}
+
+impl Evaluation {
+    /// Move the parameters that enter linearly to their weighted least-squares optimum for
+    /// the others (variable projection): each unbalance whose mud and alpha are both
+    /// unknown (the response is linear in U = mud e^{i alpha}) and the initial state. The
+    /// response and the unbalances' sensitivity columns are updated exactly. After it, a
+    /// joint Gauss-Newton step is Kaufman's variable-projection step.
+    pub(crate) fn solve_linear(
+        &mut self,
+        problem: &FeProblem,
+        rotor: &mut FiniteElementRotor,
+        x0: &mut DVector<f64>,
+        data: &[&[f64]],
+        w: &[f64],
+    ) {
+        if self.jac.is_empty() {
+            return;
+        }
+        let unknowns = problem.unknowns();
+        let np = unknowns.len();
+        let mut lin: Vec<usize> = Vec::new();
+        let mut pairs: Vec<(usize, usize, usize)> = Vec::new();
+        for (i, p) in unknowns.iter().enumerate() {
+            if let FeParameter::Mud { index } = *p {
+                if let Some(ia) = unknowns
+                    .iter()
+                    .position(|q| *q == FeParameter::Alpha { index })
+                {
+                    if rotor.unbalances[index].mud > 0.0 {
+                        lin.push(i);
+                        lin.push(ia);
+                        pairs.push((index, i, ia));
+                    }
+                }
+            }
+        }
+        lin.extend(np..self.jac.len());
+        if lin.is_empty() {
+            return;
+        }
+        let sub = Evaluation {
+            y: self.y.clone(),
+            jac: lin.iter().map(|&i| self.jac[i].clone()).collect(),
+            k: self.k,
+            units: Vec::new(),
+        };
+        let (a, g) = normal_equations(&sub, Some((data, self.k)), w);
+        let Some(delta) = super::result::inverse(&a).map(|c| c * g) else {
+            return;
+        };
+        // y += J_L delta (exact: linear)
+        for (col, &i) in lin.iter().enumerate() {
+            let d = delta[col];
+            for (yc, jc) in self.y.iter_mut().zip(&self.jac[i]) {
+                for (v, j) in yc.iter_mut().zip(jc) {
+                    *v += d * j;
+                }
+            }
+        }
+        for (col, &i) in lin.iter().enumerate() {
+            if i >= np {
+                x0[i - np] += delta[col];
+            }
+        }
+        for &(j, im, ia) in &pairs {
+            let (cm, ca) = (
+                lin.iter().position(|&x| x == im).unwrap_or(0),
+                lin.iter().position(|&x| x == ia).unwrap_or(0),
+            );
+            let u = &mut rotor.unbalances[j];
+            let c = Complex::from_polar(u.mud, u.alpha);
+            let nc = c
+                + Complex::from_polar(1.0, u.alpha) * delta[cm]
+                + Complex::new(0.0, 1.0) * c * delta[ca];
+            u.mud = nc.norm();
+            u.alpha = nc.arg();
+            // the columns at the new U
+            let e = Complex::from_polar(1.0, u.alpha);
+            for (col, (a, b)) in [(im, (e.re, e.im)), (ia, (-nc.im, nc.re))] {
+                for ((o, y0), y1) in self.jac[col]
+                    .iter_mut()
+                    .zip(&self.units[j][0])
+                    .zip(&self.units[j][1])
+                {
+                    for ((v, p), q) in o.iter_mut().zip(y0).zip(y1) {
+                        *v = a * p + b * q;
+                    }
+                }
+            }
+        }
     }
 }
 

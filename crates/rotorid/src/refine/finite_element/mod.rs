@@ -44,6 +44,7 @@
 
 mod evaluate;
 mod result;
+mod summary;
 
 use nalgebra::{DMatrix, DVector};
 
@@ -56,6 +57,10 @@ use crate::simulate::SimulateError;
 
 pub use evaluate::FeProblem;
 pub use result::{FeFittedValue, FeReduction, FeRefined, FeWarning};
+pub use summary::{
+    FeAdequacy, FeBearingSummary, FeCovariance, FeInitialStateSummary, FeNoise, FeParameterSummary,
+    FeRecordSummary, FeRotorSummary, FeSummary, FeUnbalanceSummary,
+};
 
 /// The initial state of a finite-element fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -371,6 +376,7 @@ impl<'a> Fit<'a> {
         let k = at.0;
         let mut eval = p.evaluate(&self.rotor, self.basis.matrix(), &self.x0, at, true)?;
         self.weights = evaluate::noise_weights(self.y, at);
+        eval.solve_linear(p, &mut self.rotor, &mut self.x0, self.y, &self.weights);
         let mut cost = eval.cost(self.y, k, &self.weights);
         let mut lambda = 1e-3;
         let mut trials = 0;
@@ -411,7 +417,9 @@ impl<'a> Fit<'a> {
             };
             trials += 1;
             let basis = RitzBasis::new(&rotor, p.modes())?;
-            let trial = p.evaluate(&rotor, basis.matrix(), &x0, at, true)?;
+            let (mut rotor, mut x0) = (rotor, x0);
+            let mut trial = p.evaluate(&rotor, basis.matrix(), &x0, at, true)?;
+            trial.solve_linear(p, &mut rotor, &mut x0, self.y, &self.weights);
             let new_cost = trial.cost(self.y, k, &self.weights);
             if new_cost <= cost {
                 self.rotor = rotor;

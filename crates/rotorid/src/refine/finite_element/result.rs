@@ -269,6 +269,7 @@ pub(crate) fn finish(
             y: Vec::new(),
             jac: Vec::new(),
             k: 1,
+            units: Vec::new(),
         };
         // delta y as the "data" of a normal-equation right-hand side: J^T W (yf - y)
         shift.y.clone_from(&eval.y);

@@ -7,7 +7,10 @@ use std::sync::Arc;
 
 use nalgebra::{Complex, DMatrix, DVector};
 use rotorid::model::finite_element::{Bearing, Dof, FeMatrices, FeUnbalance, FiniteElementRotor};
-use rotorid::simulate::finite_element::FeResponse;
+use rotorid::model::finite_element::FeSystem;
+use rotorid::model::{Sampling, SpeedProfile};
+use rotorid::simulate::add_noise_to;
+use rotorid::simulate::finite_element::{simulate_fe, FeMethod, FeResponse};
 use serde_json::Value;
 
 pub const ROSS_TWO_DISK: &str = include_str!("../fe_fixture/ross_two_disk.json");
@@ -122,4 +125,53 @@ pub fn probes() -> Vec<Dof> {
         .iter()
         .map(|s| s.parse().unwrap())
         .collect()
+}
+
+/// The truth's response at the probes from rest, with noise at `snr_db` (seed).
+pub fn record(
+    rotor: &FiniteElementRotor,
+    speed: &SpeedProfile,
+    duration: f64,
+    snr_db: f64,
+    seed: u64,
+) -> (FeResponse, Vec<f64>) {
+    let method = if speed.is_constant() {
+        FeMethod::Exact
+    } else {
+        FeMethod::Magnus
+    };
+    let mut r = simulate_fe(
+        &FeSystem::full(rotor),
+        speed,
+        &Sampling::new(1e-4, duration).unwrap(),
+        None,
+        Some(&probes()),
+        method,
+    )
+    .unwrap();
+    let names = ["0.x", "0.y", "10.x", "10.y"];
+    let mut chans: Vec<(&'static str, &mut [f64])> = names
+        .iter()
+        .zip(r.q.iter_mut())
+        .map(|(n, c)| (*n, c.as_mut_slice()))
+        .collect();
+    let sigma = add_noise_to(&mut chans, snr_db, seed).unwrap();
+    (r, sigma)
+}
+
+/// An engineering guess: direct coefficients 30-70 % off, angles 40 deg off, mud 50 % off.
+pub fn guess(truth: &FiniteElementRotor) -> FiniteElementRotor {
+    let mut g = truth.clone();
+    let f = [1.5, 0.6, 1.4, 0.7];
+    for (i, b) in g.bearings.iter_mut().enumerate() {
+        b.kxx *= f[i % 4];
+        b.kyy *= f[(i + 1) % 4];
+        b.cxx *= f[(i + 2) % 4];
+        b.cyy *= f[(i + 3) % 4];
+    }
+    for (j, u) in g.unbalances.iter_mut().enumerate() {
+        u.mud *= if j == 0 { 1.5 } else { 0.6 };
+        u.alpha += 40f64.to_radians() * if j == 0 { 1.0 } else { -1.0 };
+    }
+    g
 }
