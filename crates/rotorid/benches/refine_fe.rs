@@ -3,7 +3,7 @@
 //! both bearings (x, y) simulated with the full model, 40 dB, the fit started from the
 //! engineering guess of the tests (bearing coefficients 30-70 % off, unbalance angles 40
 //! deg off), the default unknowns (8 direct bearing coefficients, 2 unbalances),
-//! reduced to 8 modes + static shapes. Each iteration is a whole `refine_fe` (including
+//! reduced to 6 modes + static shapes (the default). Each iteration is a whole `refine_fe` (including
 //! the reduction's bias check, one full-model simulation). One thread.
 //!
 //! `cargo bench -p rotorid --bench refine_fe`

@@ -34,10 +34,10 @@ mod refine_run;
 mod session;
 mod start;
 
+pub(crate) use adequacy::channel as channel_adequacy;
 pub use adequacy::{
     Adequacy, ChannelAdequacy, ADEQUACY_P_MIN, LJUNG_BOX_LAGS, NOISE_RATIO_MAX, RESIDUAL_FLOOR,
 };
-pub(crate) use adequacy::channel as channel_adequacy;
 pub use consistency::SPEED_FACTOR_TOLERANCE;
 pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};
 pub use error::PipelineError;

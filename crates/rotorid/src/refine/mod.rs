@@ -58,10 +58,10 @@
 //! `crb` (bound, model response), `result` (reported structures, warnings).
 
 mod crb;
-pub mod finite_element;
 mod discretisation;
 mod error;
 mod exact_step;
+pub mod finite_element;
 mod fisher;
 mod lm;
 mod record;

@@ -50,7 +50,10 @@ fn fe_refine_recovers_bearings_and_unbalances_on_a_run_up_from_rest() {
     options.initial = FeInitial::Rest;
     let t0 = std::time::Instant::now();
     let mut fit = refine_fe(&data, &start, &options).unwrap();
-    eprintln!("run-up 0 -> 450 rad/s in 2 s, 40 dB, fit in {:?}", t0.elapsed());
+    eprintln!(
+        "run-up 0 -> 450 rad/s in 2 s, 40 dB, fit in {:?}",
+        t0.elapsed()
+    );
     let crb = crb_fe(&data, &truth, &options.unknowns, FeInitial::Rest, &sigma, 8).unwrap();
     fit.attach_crb(&crb);
     let worst = report(&fit, &truth);
@@ -79,7 +82,10 @@ fn fe_refine_recovers_bearings_and_unbalances_at_constant_speed_from_rest() {
     options.initial = FeInitial::Rest;
     let t0 = std::time::Instant::now();
     let mut fit = refine_fe(&data, &start, &options).unwrap();
-    eprintln!("constant 200 rad/s 1 s from rest, 40 dB, fit in {:?}", t0.elapsed());
+    eprintln!(
+        "constant 200 rad/s 1 s from rest, 40 dB, fit in {:?}",
+        t0.elapsed()
+    );
     let crb = crb_fe(&data, &truth, &options.unknowns, FeInitial::Rest, &sigma, 8).unwrap();
     fit.attach_crb(&crb);
     let worst = report(&fit, &truth);
@@ -105,10 +111,58 @@ fn fe_refine_fast_run_up_of_the_benchmark() {
     options.initial = FeInitial::Rest;
     let t0 = std::time::Instant::now();
     let mut fit = refine_fe(&data, &guess(&truth), &options).unwrap();
-    eprintln!("run-up 0 -> 450 rad/s in 1 s, 40 dB, fit in {:?}", t0.elapsed());
+    eprintln!(
+        "run-up 0 -> 450 rad/s in 1 s, 40 dB, fit in {:?}",
+        t0.elapsed()
+    );
     let crb = crb_fe(&data, &truth, &options.unknowns, FeInitial::Rest, &sigma, 8).unwrap();
     fit.attach_crb(&crb);
     let worst = report(&fit, &truth);
     assert!(fit.converged && fit.identifiable, "{:?}", fit.warnings);
     assert!(worst < 4.5, "{worst}");
+}
+
+#[test]
+fn fe_refine_estimates_the_initial_state_of_a_record_taken_mid_run() {
+    // 1.2 s at constant speed from rest, the first 0.2 s cut off: the record starts in a
+    // transient (the lowest mode decays in ~0.4 s), its initial state unknown
+    let truth = ross_rotor();
+    let omega = 250.0;
+    let speed = SpeedProfile::Constant { omega, phi0: 0.0 };
+    let (whole, sigma) = record(&truth, &speed, 1.2, 40.0, 4);
+    let cut = 2000;
+    let mut rec = whole.clone();
+    rec.t = whole.t[cut..].to_vec();
+    for c in rec.q.iter_mut() {
+        c.drain(..cut);
+    }
+    rec.phi.drain(..cut);
+    rec.phi_dot.drain(..cut);
+    rec.phi_ddot.drain(..cut);
+    let data = FeData {
+        response: &rec,
+        speed: SpeedProfile::Constant {
+            omega,
+            phi0: omega * whole.t[cut],
+        },
+    };
+    let options = FeRefineOptions::new(&truth);
+    assert_eq!(options.initial, FeInitial::Estimated);
+    let t0 = std::time::Instant::now();
+    let fit = refine_fe(&data, &guess(&truth), &options).unwrap();
+    eprintln!(
+        "constant {omega} rad/s, 1 s from t = 0.2 s, initial state estimated, fit in {:?}",
+        t0.elapsed()
+    );
+    let worst = report(&fit, &truth);
+    assert!(fit.converged && fit.identifiable, "{:?}", fit.warnings);
+    assert!(fit.model_adequate, "{:?}", fit.adequacy);
+    assert!(worst < 4.5, "{worst}");
+    // the fitted initial state in full coordinates is the truth's state at 0.2 s: its
+    // response at the probes starts where the data start (to the noise)
+    let s = fit.initial_state.as_ref().unwrap();
+    assert_eq!(s.q.len(), truth.matrices.n());
+    for (c, col) in fit.model_response.iter().enumerate() {
+        assert!((col[0] - rec.q[c][0]).abs() < 5.0 * sigma[c], "{c}");
+    }
 }

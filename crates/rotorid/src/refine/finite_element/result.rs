@@ -187,7 +187,13 @@ pub(crate) fn finish(
 ) -> Result<super::FeRefined, FeRefineError> {
     let eval: Evaluation = match fit.eval.take() {
         Some(e) if e.k == 1 && e.y[0].len() == problem.samples() => e,
-        _ => problem.evaluate(&fit.rotor, fit.basis.matrix(), &fit.x0, (1, problem.samples()), true)?,
+        _ => problem.evaluate(
+            &fit.rotor,
+            fit.basis.matrix(),
+            &fit.x0,
+            (1, problem.samples()),
+            true,
+        )?,
     };
     let weights = eval.residual_weights(y, 1);
     let (a, _) = normal_equations(&eval, None, &weights);
@@ -335,8 +341,7 @@ pub(crate) fn finish(
         .map(|(d, w)| (*d, 1.0 / w.sqrt()))
         .collect();
     let model_adequate = adequacy.iter().all(|(_, a)| a.adequate);
-    let initial_state =
-        (problem.nuisance() > 0).then(|| full_initial(fit.basis.matrix(), &fit.x0));
+    let initial_state = (problem.nuisance() > 0).then(|| full_initial(fit.basis.matrix(), &fit.x0));
     Ok(super::FeRefined {
         parameters,
         initial: problem.initial(),

@@ -6,8 +6,8 @@
 use std::sync::Arc;
 
 use nalgebra::{Complex, DMatrix, DVector};
-use rotorid::model::finite_element::{Bearing, Dof, FeMatrices, FeUnbalance, FiniteElementRotor};
 use rotorid::model::finite_element::FeSystem;
+use rotorid::model::finite_element::{Bearing, Dof, FeMatrices, FeUnbalance, FiniteElementRotor};
 use rotorid::model::{Sampling, SpeedProfile};
 use rotorid::simulate::add_noise_to;
 use rotorid::simulate::finite_element::{simulate_fe, FeMethod, FeResponse};
