@@ -166,3 +166,47 @@ fn fe_refine_estimates_the_initial_state_of_a_record_taken_mid_run() {
         assert!((col[0] - rec.q[c][0]).abs() < 5.0 * sigma[c], "{c}");
     }
 }
+
+#[test]
+fn fe_refine_refuses_bad_input_by_name() {
+    let truth = ross_rotor();
+    let speed = SpeedProfile::Constant {
+        omega: 200.0,
+        phi0: 0.0,
+    };
+    let (rec, _) = record(&truth, &speed, 0.05, 40.0, 5);
+    let opts = FeRefineOptions::new(&truth);
+    let err = |r: &rotorid::simulate::finite_element::FeResponse, o: &FeRefineOptions| {
+        refine_fe(&FeData { response: r, speed }, &truth, o)
+            .unwrap_err()
+            .to_string()
+    };
+    // a stamp off the grid
+    let mut bad = rec.clone();
+    bad.t[7] += 0.5e-4;
+    let e = err(&bad, &opts);
+    assert!(e.contains("sample 7") && e.contains("uniform"), "{e}");
+    // a non-finite value names its channel and sample
+    let mut bad = rec.clone();
+    bad.q[2][11] = f64::NAN;
+    let e = err(&bad, &opts);
+    assert!(e.contains("10.x") && e.contains("sample 11"), "{e}");
+    // a channel the matrices do not have
+    let mut bad = rec.clone();
+    bad.dofs[0] = "99.x".parse().unwrap();
+    let e = err(&bad, &opts);
+    assert!(e.contains("99.x") && e.contains("0.x, 0.y"), "{e}");
+    // nothing to estimate
+    let mut o = opts.clone();
+    o.unknowns.clear();
+    o.initial = FeInitial::Rest;
+    assert!(err(&rec, &o).contains("no unknown"));
+    // too few samples for 12 unknowns and 36 initial coordinates
+    let mut short = rec.clone();
+    short.t.truncate(100);
+    for c in short.q.iter_mut() {
+        c.truncate(100);
+    }
+    let e = err(&short, &opts);
+    assert!(e.contains("100 samples") && e.contains("480"), "{e}");
+}

@@ -102,7 +102,8 @@ pub struct FeParameterSummary {
     pub truth: Option<f64>,
     /// (value - truth) / truth.
     pub relative_error: Option<f64>,
-    /// Finite standard error below |value| (angles: below 1 rad).
+    /// Finite standard error below |value| (angles: below 1 rad), the unknowns identifiable
+    /// and every channel adequate (else `value` is withheld, as for the 2-DOF models).
     pub determined: bool,
     /// Where the fit started \[unit\].
     pub start: f64,
@@ -198,7 +199,9 @@ impl FeSummary {
             .iter()
             .map(|p| {
                 let angle = p.unit == "rad";
-                let determined = p.std_error.is_finite()
+                let determined = fit.identifiable
+                    && fit.model_adequate
+                    && p.std_error.is_finite()
                     && if angle {
                         p.std_error < 1.0
                     } else {
