@@ -410,6 +410,33 @@ fn matrix<'py>(py: Python<'py>, n: usize, row_major: Vec<f64>) -> PyResult<Bound
         .into_any())
 }
 
+/// Identify a finite-element rotor (`crate::finite_element::identify`): the summary as
+/// JSON text.
+#[pyfunction]
+#[pyo3(signature = (t, channels, scenario, unknowns=None, initial=None, modes=None))]
+fn identify_finite_element(
+    py: Python<'_>,
+    t: Vec<f64>,
+    channels: Vec<(String, Vec<f64>)>,
+    scenario: std::path::PathBuf,
+    unknowns: Option<String>,
+    initial: Option<String>,
+    modes: Option<usize>,
+) -> PyResult<String> {
+    let path = scenario.to_string_lossy().into_owned();
+    py.detach(|| {
+        crate::finite_element::identify(
+            t,
+            channels,
+            &path,
+            unknowns.as_deref(),
+            initial.as_deref(),
+            modes,
+        )
+    })
+    .map_err(py_err)
+}
+
 /// The matrices file `path` as stored (`rotorid_io::fe_matrices`): a dict of `dofs` (list
 /// of str) and `M`, `K`, `G`, `C`, `Ka` (n x n float64 arrays; `C`, `Ka` None when absent).
 #[pyfunction]
@@ -816,6 +843,7 @@ fn rotorid_extension(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(balance, m)?)?;
     m.add_function(wrap_pyfunction!(read_fe_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(load_finite_element, m)?)?;
+    m.add_function(wrap_pyfunction!(identify_finite_element, m)?)?;
     m.add("METHODS", options::METHOD_NAMES.to_vec())?;
     m.add("UNKNOWNS", options::UNKNOWN_NAMES.to_vec())?;
     m.add("MODELS", options::MODEL_NAMES.to_vec())?;

@@ -37,6 +37,7 @@ Balancing (influence coefficients of many planes, sensors and speeds)::
 from __future__ import annotations
 
 import dataclasses
+import json
 import os
 from typing import Any, Iterator, Mapping, Sequence
 
@@ -70,6 +71,7 @@ __all__ = [
     "balance",
     "identify",
     "load_finite_element",
+    "identify_finite_element",
     "plan_trials",
     "read",
     "read_blocks",
@@ -127,6 +129,61 @@ def load_finite_element(scenario: str | os.PathLike[str]) -> FiniteElementRotor:
     it, as the ``rotorid`` command loads it. Raises ``ValueError`` naming the file, the
     line or member and what is allowed, ``FileNotFoundError`` for a missing file."""
     return FiniteElementRotor(**_rotorid.load_finite_element(os.fspath(scenario)))
+
+
+def identify_finite_element(
+    data: Any,
+    scenario: str | os.PathLike[str],
+    *,
+    unknowns: str | Sequence[str] | None = None,
+    initial: str = "estimated",
+    modes: int | None = None,
+) -> dict[str, Any]:
+    """Identify the bearings and unbalances of a finite-element rotor, as ``rotorid
+    identify DATA --scenario S.toml --method refine`` does (docs/finite_element.md
+    section 5): maximum likelihood on the reduced model, started from the scenario's
+    values of the unknowns (the others known).
+
+    Args:
+        data: a DataFrame or a mapping of 1-D arrays: ``t`` [s] (uniform) and one column
+            per measured degree of freedom named ``<node>.<dof>`` (m or rad), e.g.
+            ``0.x``; ``phi``, ``phi_dot``, ``phi_ddot`` are ignored (the speed is the
+            scenario's ``[speed]`` profile from the first sample).
+        scenario: the scenario TOML (``rotor.model = "finite_element"``).
+        unknowns: names or groups (``"bearings,unbalances"``, ``["bearing0.kxx",
+            "unbalance1"]``); ``None``: every bearing's direct coefficients and every
+            unbalance.
+        initial: ``"rest"`` (the record starts at rest) or ``"estimated"``.
+        modes: modes of the Ritz basis (``None``: 6).
+
+    Returns the summary as a dict (docs/summary.md, "Finite-element rotors"): each
+    unknown with its standard error under ``parameters``, the covariance, the rotor with
+    the estimates in, the noise, the adequacy and the reduction's bias; it feeds
+    :func:`rotorid.ross.update`. Raises ``ValueError`` naming the column, field or option
+    and what is allowed.
+    """
+    if isinstance(data, pd.DataFrame):
+        names = [str(c) for c in data.columns]
+        get = lambda k: data[k].to_numpy()  # noqa: E731
+    elif isinstance(data, Mapping):
+        names = [str(c) for c in data.keys()]
+        get = lambda k: data[k]  # noqa: E731
+    else:
+        raise TypeError(
+            f"data: expected a pandas DataFrame or a dict of arrays, got {type(data).__name__}")
+    if "t" not in names:
+        raise ValueError(f"data: no column t (time, s); columns: {', '.join(names)}")
+    skip = {"t", "phi", "phi_dot", "phi_ddot"}
+    channels = [(k, np.asarray(get(k), dtype=np.float64).tolist()) for k in names if k not in skip]
+    if not channels:
+        raise ValueError("data: no measured degree of freedom (a column `<node>.<dof>`, e.g. 0.x)")
+    if isinstance(unknowns, str) or unknowns is None:
+        u = unknowns
+    else:
+        u = ",".join(unknowns)
+    t = np.asarray(get("t"), dtype=np.float64).tolist()
+    text = _rotorid.identify_finite_element(t, channels, os.fspath(scenario), u, initial, modes)
+    return json.loads(text)
 
 
 def _frame(columns: Mapping[str, np.ndarray]) -> pd.DataFrame:

@@ -187,3 +187,11 @@ class FiniteElementRotor:
     unbalances: list[dict[str, float]]
 
 def load_finite_element(scenario: str | os.PathLike[str]) -> FiniteElementRotor: ...
+def identify_finite_element(
+    data: pd.DataFrame | Mapping[str, Any],
+    scenario: str | os.PathLike[str],
+    *,
+    unknowns: str | Sequence[str] | None = None,
+    initial: str = "estimated",
+    modes: int | None = None,
+) -> dict[str, Any]: ...

@@ -31,6 +31,14 @@ def read(path: str, columns: str | None = None) -> tuple[dict[str, np.ndarray], 
 def read_blocks(path: str, columns: str | None = None, rows: int = 65536) -> Blocks: ...
 def read_fe_matrices(path: str) -> dict[str, Any]: ...
 def load_finite_element(path: str) -> dict[str, Any]: ...
+def identify_finite_element(
+    t: list[float],
+    channels: list[tuple[str, list[float]]],
+    scenario: str,
+    unknowns: str | None = None,
+    initial: str | None = None,
+    modes: int | None = None,
+) -> str: ...
 @final
 class Blocks:
     @property
