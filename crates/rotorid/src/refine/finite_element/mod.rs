@@ -110,12 +110,12 @@ pub struct FeRefineOptions {
 
 impl FeRefineOptions {
     /// The defaults for `rotor`: the direct coefficients of every bearing and every
-    /// unbalance unknown, initial state estimated, 6 modes.
+    /// unbalance unknown, initial state estimated, 6 modes (at most the degrees of freedom).
     pub fn new(rotor: &FiniteElementRotor) -> Self {
         Self {
             unknowns: FeParameter::default_unknowns(rotor),
             initial: FeInitial::Estimated,
-            modes: 6,
+            modes: 6.min(rotor.matrices.n()),
             max_iterations: 80,
             tolerance: 1e-2,
             coarse: 8,
@@ -222,6 +222,8 @@ impl FeData<'_> {
 
 /// The leading windows of the continuation (fractions of the record).
 const WINDOWS: [f64; 6] = [0.2, 0.3, 0.45, 0.65, 0.85, 1.0];
+/// Most trials of a coarse stage.
+const STAGE_TRIALS: usize = 12;
 /// Step tolerance of the coarse stages \[standard errors\].
 const COARSE_TOLERANCE: f64 = 0.3;
 
@@ -272,9 +274,15 @@ pub fn refine_fe(
     stages.push((1, n, options.tolerance));
     let mut trials = 0;
     let mut converged = false;
-    for &(k, w, tol) in &stages {
-        let budget = options.max_iterations.saturating_sub(trials);
-        let (c, used) = fit.run((k, w), tol, budget)?;
+    let last = stages.len() - 1;
+    for (s, &(k, w, tol)) in stages.iter().enumerate() {
+        let left = options.max_iterations.saturating_sub(trials);
+        let budget = if s < last {
+            left.min(STAGE_TRIALS)
+        } else {
+            left
+        };
+        let (c, used) = fit.run((k, w), tol, budget, s < last)?;
         trials += used;
         converged = c;
     }
@@ -375,6 +383,7 @@ impl<'a> Fit<'a> {
         at: (usize, usize),
         tol: f64,
         budget: usize,
+        freeze: bool,
     ) -> Result<(bool, usize), FeRefineError> {
         let p = self.problem;
         let k = at.0;
@@ -391,7 +400,13 @@ impl<'a> Fit<'a> {
             let d = self.log_scales();
             let a = DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] * d[i] * d[j]);
             let g = DVector::from_fn(g.len(), |i, _| g[i] * d[i]);
-            let Some(step) = lm_step(&a, &g, lambda) else {
+            let cov = result::inverse(&a);
+            // a coarse stage moves only what its window determines (the others keep their
+            // values until a longer window informs them: damping below the first critical)
+            let free: Vec<bool> = (0..g.len())
+                .map(|i| !freeze || self.determined(i, cov.as_ref(), &d))
+                .collect();
+            let Some(step) = lm_step(&a, &g, lambda, &free) else {
                 lambda *= 10.0;
                 if lambda > 1e12 {
                     break;
@@ -399,39 +414,40 @@ impl<'a> Fit<'a> {
                 continue;
             };
             // the step in standard errors (at lambda -> 0 the Gauss-Newton step)
-            let small = result::inverse(&a).is_some_and(|cov| {
+            let small = cov.as_ref().is_some_and(|cov| {
                 (0..step.len()).all(|i| step[i].abs() <= tol * cov[(i, i)].max(0.0).sqrt())
             });
-            if small && lambda <= 1e-2 {
+            if small && (freeze || lambda <= 1e-2) {
                 // the Gauss-Newton step is below the tolerance: taking it would not move
                 // any estimate by more than `tol` standard errors
                 converged = true;
                 break;
             }
-            let (rotor, x0) = match self.apply(&step) {
-                Some(v) => v,
-                None => {
-                    lambda *= 10.0;
-                    trials += 1;
-                    if lambda > 1e12 {
-                        break;
-                    }
-                    continue;
-                }
-            };
             trials += 1;
+            let Some((mut rotor, mut x0)) = self.apply(&step) else {
+                lambda *= 10.0;
+                if lambda > 1e12 {
+                    break;
+                }
+                continue;
+            };
             let basis = RitzBasis::new(&rotor, p.modes())?;
-            let (mut rotor, mut x0) = (rotor, x0);
             let mut trial = p.evaluate(&rotor, basis.matrix(), &x0, at, true)?;
             trial.solve_linear(p, &mut rotor, &mut x0, self.y, &self.weights);
             let new_cost = trial.cost(self.y, k, &self.weights);
             if new_cost <= cost {
+                let gain = cost - new_cost;
                 self.rotor = rotor;
                 self.x0 = x0;
                 self.basis = basis;
                 eval = trial;
                 cost = new_cost;
                 lambda = (lambda / 10.0).max(1e-9);
+                if small || gain <= 1e-12 * cost {
+                    // nothing left to gain at this stage
+                    converged = small;
+                    break;
+                }
             } else {
                 lambda *= 10.0;
                 if small || lambda > 1e12 {
@@ -443,6 +459,28 @@ impl<'a> Fit<'a> {
         }
         self.eval = Some(eval);
         Ok((converged, trials))
+    }
+
+    /// Whether the current window determines internal parameter `i` (its standard error
+    /// `cov`, in the step's coordinates: log for a positive parameter, below 0.3; an angle
+    /// below 0.5 rad; a cross coefficient below 0.3 of its bearing's direct scale; the
+    /// initial state always).
+    fn determined(&self, i: usize, cov: Option<&DMatrix<f64>>, d: &[f64]) -> bool {
+        let Some(cov) = cov else {
+            return true;
+        };
+        let s = cov[(i, i)].max(0.0).sqrt();
+        let Some(&par) = self.problem.unknowns().get(i) else {
+            return true;
+        };
+        match par {
+            _ if d[i] != 1.0 => s < 0.3,
+            FeParameter::Alpha { .. } => s < 0.5,
+            FeParameter::Bearing { index, coefficient } => {
+                s < 0.3 * evaluate::scale(&self.rotor, index, coefficient)
+            }
+            FeParameter::Mud { .. } => s < 0.3 * par.get(&self.rotor).unwrap_or(0.0).abs(),
+        }
     }
 
     /// d theta / d u for each unknown: its value for a positive one moved in log space
@@ -470,7 +508,7 @@ impl<'a> Fit<'a> {
         for (i, &par) in self.problem.unknowns().iter().enumerate() {
             let v = par.get(&rotor)?;
             let v = if d[i] != 1.0 || positive(par) && v > 0.0 {
-                v * step[i].clamp(-3.0, 3.0).exp()
+                v * step[i].clamp(-1.0, 1.0).exp()
             } else {
                 v + step[i]
             };
@@ -513,14 +551,23 @@ fn wrap(a: f64) -> f64 {
     }
 }
 
-/// (A + lambda diag A) delta = g by Cholesky; None when not positive definite.
-fn lm_step(a: &DMatrix<f64>, g: &DVector<f64>, lambda: f64) -> Option<DVector<f64>> {
-    let mut m = a.clone();
-    for i in 0..m.nrows() {
-        let d = a[(i, i)];
+/// (A + lambda diag A) delta = g over the `free` unknowns (the others 0) by Cholesky; None
+/// when not positive definite.
+fn lm_step(a: &DMatrix<f64>, g: &DVector<f64>, lambda: f64, free: &[bool]) -> Option<DVector<f64>> {
+    let idx: Vec<usize> = (0..g.len()).filter(|&i| free[i]).collect();
+    let n = idx.len();
+    let mut m = DMatrix::from_fn(n, n, |i, j| a[(idx[i], idx[j])]);
+    for i in 0..n {
+        let d = m[(i, i)];
         m[(i, i)] = d + lambda * if d > 0.0 { d } else { 1.0 };
     }
-    m.cholesky().map(|c| c.solve(g))
+    let rhs = DVector::from_fn(n, |i, _| g[idx[i]]);
+    let sub = m.cholesky().map(|c| c.solve(&rhs))?;
+    let mut step = DVector::zeros(g.len());
+    for (i, &j) in idx.iter().enumerate() {
+        step[j] = sub[i];
+    }
+    Some(step)
 }
 
 /// The initial state in full coordinates from reduced ones (q = T x0\[..r\], q' = T
