@@ -61,7 +61,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Context};
 use rotorid::analysis::{
     campbell, critical_speeds, stability_margin, stability_with_covariance, unbalance_response,
-    Campbell, CovarianceParameter, CriticalSpeed, ParameterCovariance, Probe, Stability,
+    Campbell, CovarianceParameter, CriticalSpeed, Mode, ParameterCovariance, Probe, Stability,
     StabilityMargin, UnbalanceResponse, Whirl,
 };
 use rotorid::model::{rad_per_s_to_rpm, rpm_to_rad_per_s, CrossCoupling, SpeedProfile};
@@ -77,6 +77,8 @@ use crate::plot::canvas::save_drawing;
 use crate::plot::polar::{PolarChannel, PolarPlot};
 use crate::plot::{palette, Rgb, DEFAULT_SIZE};
 use crate::report::analysis::{render_report, ReportFigure};
+
+mod finite_element;
 
 /// Version of the `analysis.json` layout.
 pub const ANALYSIS_FORMAT_VERSION: u32 = 1;
@@ -109,17 +111,20 @@ Examples:
 pub struct AnalyzeArgs {
     /// An identification summary written by `rotorid identify --summary` (its `rotor` and
     /// `covariance` fields are read).
-    #[arg(
-        value_name = "SUMMARY.json",
-        required_unless_present = "scenario",
-        conflicts_with = "scenario"
-    )]
+    #[arg(value_name = "SUMMARY.json", required_unless_present = "scenario")]
     pub summary: Option<PathBuf>,
 
     /// Analyse the rotor of a scenario instead: `table1` or a TOML scenario file (every
-    /// rotor key needed; no uncertainty).
+    /// rotor key needed; no uncertainty). With a finite-element summary: the scenario it
+    /// was identified with (its matrices; the summary's identified values replace its own).
     #[arg(long, value_name = "table1|FILE.toml")]
     pub scenario: Option<String>,
+
+    /// Finite-element rotor: how many of its lowest modes the Campbell diagram, critical
+    /// speeds and stability follow (1 ..= its degrees of freedom; default 6 or all when it
+    /// has fewer).
+    #[arg(long, value_name = "N")]
+    pub modes: Option<usize>,
 
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR")]
@@ -665,6 +670,22 @@ fn instability_text(st: &Stability, cross: bool) -> String {
 
 /// Run `rotorid analyze`.
 pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
+    if let Some(fe) = finite_element::input(&args)? {
+        return finite_element::run(&args, fe);
+    }
+    if let (Some(summary), Some(scenario)) = (&args.summary, &args.scenario) {
+        bail!(
+            "--scenario {scenario}: a scenario goes with a finite-element summary only (for its \
+             matrices); {} is a 2-DOF summary, analysed from its own rotor: drop --scenario",
+            summary.display()
+        );
+    }
+    if let Some(n) = args.modes {
+        bail!(
+            "--modes {n}: the number of modes applies to a finite-element rotor; the 2-DOF \
+             models have two"
+        );
+    }
     let (rotor, source, scenario_speed) =
         load_rotor_and_speed(args.summary.as_deref(), args.scenario.as_deref(), "analyze")?;
     let r = compute(&args, rotor, scenario_speed)?;
@@ -975,20 +996,7 @@ fn analysis_json(
         },
         rotor_std: r.covariance.as_ref().map(|c| rotor_std(p, c)),
         speed_range_rpm: args.rpm,
-        critical_speeds: r
-            .critical
-            .iter()
-            .map(|c| CriticalJson {
-                rpm: c.rpm(),
-                whirl: c.whirl(),
-                std_rpm: c.std_rpm(),
-                mode: c.mode,
-                frequency_hz: c.at.frequency_hz(),
-                damping_ratio: c.at.damping_ratio,
-                log_dec: c.at.log_dec,
-                log_dec_std: c.log_dec_std,
-            })
-            .collect(),
+        critical_speeds: r.critical.iter().map(critical_json).collect(),
         campbell: CampbellJson {
             rpm: r
                 .campbell
@@ -997,40 +1005,10 @@ fn analysis_json(
                 .map(|&w| rad_per_s_to_rpm(w))
                 .collect(),
             modes: (0..2)
-                .map(|i| ModeJson {
-                    whirl: r.campbell.whirl(i),
-                    frequency_hz: r.campbell.mode(i).map(|m| m.frequency_hz()).collect(),
-                    log_dec: r.campbell.mode(i).map(|m| m.log_dec).collect(),
-                    damping_ratio: r.campbell.mode(i).map(|m| m.damping_ratio).collect(),
-                    whirl_by_speed: r.campbell.mode(i).map(|m| m.whirl).collect(),
-                })
+                .map(|i| mode_json(r.campbell.mode(i), r.campbell.whirl(i)))
                 .collect(),
         },
-        stability: StabilityJson {
-            stable: r.stability.is_stable(),
-            min_log_dec: r.stability.min_log_dec,
-            min_log_dec_rpm: r.stability.min_log_dec_speed.map(rad_per_s_to_rpm),
-            min_log_dec_mode: r.stability.min_log_dec_mode,
-            min_damping_ratio: r.stability.min_damping_ratio,
-            threshold_rpm: r.stability.threshold_rpm(),
-            threshold_rpm_std: r.stability.threshold_std_rpm(),
-            threshold_mode: r.stability.threshold_mode,
-            threshold_whirl: r.stability.threshold_whirl,
-            unstable_at_start: r.stability.unstable_at_start,
-            stable_from_rpm: r.stability.stable_from.map(rad_per_s_to_rpm),
-            stable_from_rpm_std: r.stability.stable_from_std.map(rad_per_s_to_rpm),
-            operating: r.operating.as_ref().map(|(m, src)| OperatingJson {
-                rpm: rad_per_s_to_rpm(m.speed),
-                source: src,
-                mode: m.mode,
-                whirl: m.at.whirl,
-                frequency_hz: m.at.frequency_hz(),
-                damping_ratio: m.at.damping_ratio,
-                log_dec: m.at.log_dec,
-                log_dec_std: m.log_dec_std,
-                stable: !m.is_unstable(),
-            }),
-        },
+        stability: stability_json(&r.stability, r.operating.as_ref()),
         unbalance_response: ResponseJson {
             rpm: r
                 .response
@@ -1043,6 +1021,61 @@ fn analysis_json(
             channels,
         },
         figures: figures.to_vec(),
+    }
+}
+
+fn critical_json(c: &CriticalSpeed) -> CriticalJson {
+    CriticalJson {
+        rpm: c.rpm(),
+        whirl: c.whirl(),
+        std_rpm: c.std_rpm(),
+        mode: c.mode,
+        frequency_hz: c.at.frequency_hz(),
+        damping_ratio: c.at.damping_ratio,
+        log_dec: c.at.log_dec,
+        log_dec_std: c.log_dec_std,
+    }
+}
+
+fn mode_json<'a>(modes: impl Iterator<Item = &'a Mode>, whirl: Option<Whirl>) -> ModeJson {
+    let modes: Vec<&Mode> = modes.collect();
+    ModeJson {
+        whirl,
+        frequency_hz: modes.iter().map(|m| m.frequency_hz()).collect(),
+        log_dec: modes.iter().map(|m| m.log_dec).collect(),
+        damping_ratio: modes.iter().map(|m| m.damping_ratio).collect(),
+        whirl_by_speed: modes.iter().map(|m| m.whirl).collect(),
+    }
+}
+
+fn stability_json(
+    st: &Stability,
+    operating: Option<&(StabilityMargin, &'static str)>,
+) -> StabilityJson {
+    StabilityJson {
+        stable: st.is_stable(),
+        min_log_dec: st.min_log_dec,
+        min_log_dec_rpm: st.min_log_dec_speed.map(rad_per_s_to_rpm),
+        min_log_dec_mode: st.min_log_dec_mode,
+        min_damping_ratio: st.min_damping_ratio,
+        threshold_rpm: st.threshold_rpm(),
+        threshold_rpm_std: st.threshold_std_rpm(),
+        threshold_mode: st.threshold_mode,
+        threshold_whirl: st.threshold_whirl,
+        unstable_at_start: st.unstable_at_start,
+        stable_from_rpm: st.stable_from.map(rad_per_s_to_rpm),
+        stable_from_rpm_std: st.stable_from_std.map(rad_per_s_to_rpm),
+        operating: operating.map(|(m, src)| OperatingJson {
+            rpm: rad_per_s_to_rpm(m.speed),
+            source: src,
+            mode: m.mode,
+            whirl: m.at.whirl,
+            frequency_hz: m.at.frequency_hz(),
+            damping_ratio: m.at.damping_ratio,
+            log_dec: m.at.log_dec,
+            log_dec_std: m.log_dec_std,
+            stable: !m.is_unstable(),
+        }),
     }
 }
 
