@@ -3,6 +3,14 @@
 //! from identified (or stated) rotor parameters to the numbers an engineer decides on,
 //! with the uncertainty of the identification carried through (`rotorid::analysis`).
 //!
+//! A finite-element rotor (issue 27): `rotorid analyze --scenario fe.toml --out DIR` or
+//! `rotorid analyze SUMMARY.json --scenario fe.toml --out DIR [--modes N]` (a summary with
+//! `model` = `"finite_element"` needs its scenario for the matrices); its `analysis.json`
+//! keeps the layout below where it applies, with `model` = `"finite_element"`, `rotor` by
+//! bearings and unbalances, `campbell.modes` one per followed mode and `unbalances` per
+//! plane: the full layout is in the doc of the `finite_element` submodule
+//! (`analyze/finite_element.rs`).
+//!
 //! Writes into DIR (created if missing):
 //!
 //! - `analysis.json`: critical speeds with standard deviations, the Campbell diagram's
@@ -94,7 +102,10 @@ const REFINE_SPAN: f64 = 60.0;
 
 const ANALYZE_HELP: &str = "\
 Input: an identification summary (its `rotor` and `covariance` fields; standard deviations
-are propagated from the covariance) or a scenario (its rotor; no uncertainty).
+are propagated from the covariance) or a scenario (its rotor; no uncertainty). A
+finite-element rotor: its scenario (rotor.model = \"finite_element\"), or the summary of its
+identification with that scenario (SUMMARY.json --scenario fe.toml); --modes N follows its
+lowest N modes (default 6); the whirl is in the matrices' frame (forward from +x towards +y).
 
 Conventions: the shaft turns from +z (up) toward +x (horizontal), the sense in which the
 unbalance force turns; forward whirl is whirl in that sense. Probe angles are measured from
@@ -103,7 +114,8 @@ shaft angle from the keyphasor reference (phi = 0) to the positive peak of the s
 
 Examples:
   rotorid analyze summary.json --out analysis
-  rotorid analyze --scenario table1 --out analysis --rpm 0:4000:5 --probe 45";
+  rotorid analyze --scenario table1 --out analysis --rpm 0:4000:5 --probe 45
+  rotorid analyze fe_summary.json --scenario fe.toml --out analysis --rpm 0:12000:20 --modes 4";
 
 /// Arguments of `rotorid analyze`.
 #[derive(Debug, clap::Args)]

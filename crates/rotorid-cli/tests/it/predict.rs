@@ -124,8 +124,11 @@ pub fn cov_json(m: &[Vec<f64>]) -> serde_json::Value {
     json!({"names": NAMES, "matrix": m})
 }
 
+/// A CSV's header and rows (an empty cell: None).
+type Table = (String, Vec<Vec<Option<f64>>>);
+
 /// `rotorid predict ARGS --out -`: (header, rows), or the error text.
-fn predict(args: &[&str]) -> Result<(String, Vec<Vec<Option<f64>>>), String> {
+fn predict(args: &[&str]) -> Result<Table, String> {
     let out = rotorid()
         .arg("predict")
         .args(args)
@@ -406,9 +409,9 @@ fn predict_std_matches_a_monte_carlo_during_the_transient_and_starts_from_the_es
         r.unbalances[0].mud += e[4];
         r.unbalances[0].alpha += e[5];
         let resp = run(&r);
-        for (si, &k) in samples.iter().enumerate() {
-            for j in 0..2 {
-                sum2[si][j] += (resp.q[j][k] - base.q[j][k]).powi(2);
+        for (acc, &k) in sum2.iter_mut().zip(&samples) {
+            for (j, a) in acc.iter_mut().enumerate() {
+                *a += (resp.q[j][k] - base.q[j][k]).powi(2);
             }
         }
     }

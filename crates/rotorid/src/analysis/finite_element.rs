@@ -379,14 +379,14 @@ impl Solver {
             .take(count)
             .filter_map(|&l| self.refine(w, l))
             .collect();
-        for i in 0..out.len() {
-            let li = out[i].l;
+        for e in &mut out {
+            let li = e.l;
             let double = ev
                 .iter()
                 .filter(|&&e| (e - li).norm() <= DOUBLE * li.norm())
                 .count()
                 > 1;
-            out[i].simple = !double;
+            e.simple = !double;
         }
         out.sort_by(|a, b| a.l.im.total_cmp(&b.l.im));
         out
@@ -675,16 +675,13 @@ pub fn fe_analysis(
     // critical speeds: Im lambda_j(W) - W changes sign
     let mut critical = Vec::new();
     for j in 0..modes {
-        for k in 1..speeds.len() {
-            let (ea, eb) = (&tracked[k - 1][j], &tracked[k][j]);
-            if (ea.l.im > speeds[k - 1]) == (eb.l.im > speeds[k]) {
+        for (k, pair) in tracked.windows(2).enumerate() {
+            let (ea, eb) = (&pair[0][j], &pair[1][j]);
+            let (wa, wb) = (speeds[k], speeds[k + 1]);
+            if (ea.l.im > wa) == (eb.l.im > wb) {
                 continue;
             }
-            let (wc, e) = solver.root(
-                |e, w, dl| (e.l.im - w, dl.im - 1.0),
-                (speeds[k - 1], ea),
-                (speeds[k], eb),
-            );
+            let (wc, e) = solver.root(|e, w, dl| (e.l.im - w, dl.im - 1.0), (wa, ea), (wb, eb));
             critical.push(critical_speed(&solver, j, wc, &e, &params, cov));
         }
     }
