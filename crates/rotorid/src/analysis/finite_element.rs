@@ -890,7 +890,7 @@ pub fn fe_stability_margin(
 /// One unbalance of a finite-element rotor with its uncertainty ([`fe_unbalances`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FeUnbalanceEstimate {
-    /// Its position in `[[rotor.unbalance]]` (unbalance<index>).
+    /// Its position in `[[rotor.unbalance]]` (`unbalance<index>`).
     pub index: usize,
     /// The node it stands at (the plane; its axial position is not in the matrices file).
     pub node: u32,
