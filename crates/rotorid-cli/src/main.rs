@@ -53,6 +53,9 @@ enum Command {
     Plot(commands::plot::PlotArgs),
     /// Campbell diagram, critical speeds, stability and unbalance response, with uncertainty.
     Analyze(commands::analyze::AnalyzeArgs),
+    /// The identified finite-element rotor's response at unmeasured degrees of freedom, with
+    /// a standard-deviation band from the identification's covariance.
+    Predict(commands::predict::PredictArgs),
     /// Correction masses with their uncertainty: multi-plane, multi-speed influence
     /// coefficients (least squares or min-max, split into holes, trial planning), or one
     /// plane from an identified unbalance or two runs.
@@ -78,6 +81,7 @@ fn main() {
         Command::Paper(args) => commands::paper::run(args),
         Command::Plot(args) => commands::plot::run(args),
         Command::Analyze(args) => commands::analyze::run(args),
+        Command::Predict(args) => commands::predict::run(args),
         Command::Balance(args) => commands::balance::run(*args),
         Command::Onex(args) => commands::onex::run(args),
         Command::Condition(args) => commands::condition::run(args),

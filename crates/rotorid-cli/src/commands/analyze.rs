@@ -3,6 +3,14 @@
 //! from identified (or stated) rotor parameters to the numbers an engineer decides on,
 //! with the uncertainty of the identification carried through (`rotorid::analysis`).
 //!
+//! A finite-element rotor (issue 27): `rotorid analyze --scenario fe.toml --out DIR` or
+//! `rotorid analyze SUMMARY.json --scenario fe.toml --out DIR [--modes N]` (a summary with
+//! `model` = `"finite_element"` needs its scenario for the matrices); its `analysis.json`
+//! keeps the layout below where it applies, with `model` = `"finite_element"`, `rotor` by
+//! bearings and unbalances, `campbell.modes` one per followed mode and `unbalances` per
+//! plane: the full layout is in the doc of the `finite_element` submodule
+//! (`analyze/finite_element.rs`).
+//!
 //! Writes into DIR (created if missing):
 //!
 //! - `analysis.json`: critical speeds with standard deviations, the Campbell diagram's
@@ -61,7 +69,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Context};
 use rotorid::analysis::{
     campbell, critical_speeds, stability_margin, stability_with_covariance, unbalance_response,
-    Campbell, CovarianceParameter, CriticalSpeed, ParameterCovariance, Probe, Stability,
+    Campbell, CovarianceParameter, CriticalSpeed, Mode, ParameterCovariance, Probe, Stability,
     StabilityMargin, UnbalanceResponse, Whirl,
 };
 use rotorid::model::{rad_per_s_to_rpm, rpm_to_rad_per_s, CrossCoupling, SpeedProfile};
@@ -78,6 +86,8 @@ use crate::plot::polar::{PolarChannel, PolarPlot};
 use crate::plot::{palette, Rgb, DEFAULT_SIZE};
 use crate::report::analysis::{render_report, ReportFigure};
 
+mod finite_element;
+
 /// Version of the `analysis.json` layout.
 pub const ANALYSIS_FORMAT_VERSION: u32 = 1;
 
@@ -92,7 +102,10 @@ const REFINE_SPAN: f64 = 60.0;
 
 const ANALYZE_HELP: &str = "\
 Input: an identification summary (its `rotor` and `covariance` fields; standard deviations
-are propagated from the covariance) or a scenario (its rotor; no uncertainty).
+are propagated from the covariance) or a scenario (its rotor; no uncertainty). A
+finite-element rotor: its scenario (rotor.model = \"finite_element\"), or the summary of its
+identification with that scenario (SUMMARY.json --scenario fe.toml); --modes N follows its
+lowest N modes (default 6); the whirl is in the matrices' frame (forward from +x towards +y).
 
 Conventions: the shaft turns from +z (up) toward +x (horizontal), the sense in which the
 unbalance force turns; forward whirl is whirl in that sense. Probe angles are measured from
@@ -101,7 +114,8 @@ shaft angle from the keyphasor reference (phi = 0) to the positive peak of the s
 
 Examples:
   rotorid analyze summary.json --out analysis
-  rotorid analyze --scenario table1 --out analysis --rpm 0:4000:5 --probe 45";
+  rotorid analyze --scenario table1 --out analysis --rpm 0:4000:5 --probe 45
+  rotorid analyze fe_summary.json --scenario fe.toml --out analysis --rpm 0:12000:20 --modes 4";
 
 /// Arguments of `rotorid analyze`.
 #[derive(Debug, clap::Args)]
@@ -109,17 +123,20 @@ Examples:
 pub struct AnalyzeArgs {
     /// An identification summary written by `rotorid identify --summary` (its `rotor` and
     /// `covariance` fields are read).
-    #[arg(
-        value_name = "SUMMARY.json",
-        required_unless_present = "scenario",
-        conflicts_with = "scenario"
-    )]
+    #[arg(value_name = "SUMMARY.json", required_unless_present = "scenario")]
     pub summary: Option<PathBuf>,
 
     /// Analyse the rotor of a scenario instead: `table1` or a TOML scenario file (every
-    /// rotor key needed; no uncertainty).
+    /// rotor key needed; no uncertainty). With a finite-element summary: the scenario it
+    /// was identified with (its matrices; the summary's identified values replace its own).
     #[arg(long, value_name = "table1|FILE.toml")]
     pub scenario: Option<String>,
+
+    /// Finite-element rotor: how many of its lowest modes the Campbell diagram, critical
+    /// speeds and stability follow (1 ..= its degrees of freedom; default 6 or all when it
+    /// has fewer).
+    #[arg(long, value_name = "N")]
+    pub modes: Option<usize>,
 
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR")]
@@ -665,6 +682,22 @@ fn instability_text(st: &Stability, cross: bool) -> String {
 
 /// Run `rotorid analyze`.
 pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
+    if let Some(fe) = finite_element::input(&args)? {
+        return finite_element::run(&args, fe);
+    }
+    if let (Some(summary), Some(scenario)) = (&args.summary, &args.scenario) {
+        bail!(
+            "--scenario {scenario}: a scenario goes with a finite-element summary only (for its \
+             matrices); {} is a 2-DOF summary, analysed from its own rotor: drop --scenario",
+            summary.display()
+        );
+    }
+    if let Some(n) = args.modes {
+        bail!(
+            "--modes {n}: the number of modes applies to a finite-element rotor; the 2-DOF \
+             models have two"
+        );
+    }
     let (rotor, source, scenario_speed) =
         load_rotor_and_speed(args.summary.as_deref(), args.scenario.as_deref(), "analyze")?;
     let r = compute(&args, rotor, scenario_speed)?;
@@ -975,20 +1008,7 @@ fn analysis_json(
         },
         rotor_std: r.covariance.as_ref().map(|c| rotor_std(p, c)),
         speed_range_rpm: args.rpm,
-        critical_speeds: r
-            .critical
-            .iter()
-            .map(|c| CriticalJson {
-                rpm: c.rpm(),
-                whirl: c.whirl(),
-                std_rpm: c.std_rpm(),
-                mode: c.mode,
-                frequency_hz: c.at.frequency_hz(),
-                damping_ratio: c.at.damping_ratio,
-                log_dec: c.at.log_dec,
-                log_dec_std: c.log_dec_std,
-            })
-            .collect(),
+        critical_speeds: r.critical.iter().map(critical_json).collect(),
         campbell: CampbellJson {
             rpm: r
                 .campbell
@@ -997,40 +1017,10 @@ fn analysis_json(
                 .map(|&w| rad_per_s_to_rpm(w))
                 .collect(),
             modes: (0..2)
-                .map(|i| ModeJson {
-                    whirl: r.campbell.whirl(i),
-                    frequency_hz: r.campbell.mode(i).map(|m| m.frequency_hz()).collect(),
-                    log_dec: r.campbell.mode(i).map(|m| m.log_dec).collect(),
-                    damping_ratio: r.campbell.mode(i).map(|m| m.damping_ratio).collect(),
-                    whirl_by_speed: r.campbell.mode(i).map(|m| m.whirl).collect(),
-                })
+                .map(|i| mode_json(r.campbell.mode(i), r.campbell.whirl(i)))
                 .collect(),
         },
-        stability: StabilityJson {
-            stable: r.stability.is_stable(),
-            min_log_dec: r.stability.min_log_dec,
-            min_log_dec_rpm: r.stability.min_log_dec_speed.map(rad_per_s_to_rpm),
-            min_log_dec_mode: r.stability.min_log_dec_mode,
-            min_damping_ratio: r.stability.min_damping_ratio,
-            threshold_rpm: r.stability.threshold_rpm(),
-            threshold_rpm_std: r.stability.threshold_std_rpm(),
-            threshold_mode: r.stability.threshold_mode,
-            threshold_whirl: r.stability.threshold_whirl,
-            unstable_at_start: r.stability.unstable_at_start,
-            stable_from_rpm: r.stability.stable_from.map(rad_per_s_to_rpm),
-            stable_from_rpm_std: r.stability.stable_from_std.map(rad_per_s_to_rpm),
-            operating: r.operating.as_ref().map(|(m, src)| OperatingJson {
-                rpm: rad_per_s_to_rpm(m.speed),
-                source: src,
-                mode: m.mode,
-                whirl: m.at.whirl,
-                frequency_hz: m.at.frequency_hz(),
-                damping_ratio: m.at.damping_ratio,
-                log_dec: m.at.log_dec,
-                log_dec_std: m.log_dec_std,
-                stable: !m.is_unstable(),
-            }),
-        },
+        stability: stability_json(&r.stability, r.operating.as_ref()),
         unbalance_response: ResponseJson {
             rpm: r
                 .response
@@ -1043,6 +1033,61 @@ fn analysis_json(
             channels,
         },
         figures: figures.to_vec(),
+    }
+}
+
+fn critical_json(c: &CriticalSpeed) -> CriticalJson {
+    CriticalJson {
+        rpm: c.rpm(),
+        whirl: c.whirl(),
+        std_rpm: c.std_rpm(),
+        mode: c.mode,
+        frequency_hz: c.at.frequency_hz(),
+        damping_ratio: c.at.damping_ratio,
+        log_dec: c.at.log_dec,
+        log_dec_std: c.log_dec_std,
+    }
+}
+
+fn mode_json<'a>(modes: impl Iterator<Item = &'a Mode>, whirl: Option<Whirl>) -> ModeJson {
+    let modes: Vec<&Mode> = modes.collect();
+    ModeJson {
+        whirl,
+        frequency_hz: modes.iter().map(|m| m.frequency_hz()).collect(),
+        log_dec: modes.iter().map(|m| m.log_dec).collect(),
+        damping_ratio: modes.iter().map(|m| m.damping_ratio).collect(),
+        whirl_by_speed: modes.iter().map(|m| m.whirl).collect(),
+    }
+}
+
+fn stability_json(
+    st: &Stability,
+    operating: Option<&(StabilityMargin, &'static str)>,
+) -> StabilityJson {
+    StabilityJson {
+        stable: st.is_stable(),
+        min_log_dec: st.min_log_dec,
+        min_log_dec_rpm: st.min_log_dec_speed.map(rad_per_s_to_rpm),
+        min_log_dec_mode: st.min_log_dec_mode,
+        min_damping_ratio: st.min_damping_ratio,
+        threshold_rpm: st.threshold_rpm(),
+        threshold_rpm_std: st.threshold_std_rpm(),
+        threshold_mode: st.threshold_mode,
+        threshold_whirl: st.threshold_whirl,
+        unstable_at_start: st.unstable_at_start,
+        stable_from_rpm: st.stable_from.map(rad_per_s_to_rpm),
+        stable_from_rpm_std: st.stable_from_std.map(rad_per_s_to_rpm),
+        operating: operating.map(|(m, src)| OperatingJson {
+            rpm: rad_per_s_to_rpm(m.speed),
+            source: src,
+            mode: m.mode,
+            whirl: m.at.whirl,
+            frequency_hz: m.at.frequency_hz(),
+            damping_ratio: m.at.damping_ratio,
+            log_dec: m.at.log_dec,
+            log_dec_std: m.log_dec_std,
+            stable: !m.is_unstable(),
+        }),
     }
 }
 

@@ -11,6 +11,7 @@ pub mod inspect;
 pub mod onex;
 pub mod paper;
 pub mod plot;
+pub mod predict;
 pub mod publish;
 pub mod simulate;
 pub mod worker;

@@ -238,9 +238,10 @@ fn raw_table(file: &str, raw: rotorid::acquisition::RawRecord) -> rotorid_io::Ta
     }
 }
 
-/// Write `t` to `path`: CSV (header = names, shortest round-trip numbers) or a binary
-/// format by the extension.
-fn write_any(path: &str, t: &rotorid_io::Table) -> anyhow::Result<()> {
+/// Write `t` to `path`: CSV (header = names, shortest round-trip numbers; a non-finite
+/// value, which only `rotorid predict`'s unknown standard deviations are, as an empty
+/// cell) or a binary format by the extension.
+pub(crate) fn write_any(path: &str, t: &rotorid_io::Table) -> anyhow::Result<()> {
     let format = rotorid_io::Format::from_path(std::path::Path::new(path));
     if path != "-" && !matches!(format, Ok(rotorid_io::Format::Csv) | Err(_)) {
         rotorid_io::write_table(path, t)?;
@@ -254,7 +255,11 @@ fn write_any(path: &str, t: &rotorid_io::Table) -> anyhow::Result<()> {
     let n = t.channels.first().map_or(0, |c| c.data.len());
     for i in 0..n {
         row.clear();
-        row.extend(t.channels.iter().map(|c| Some(c.data[i])));
+        row.extend(
+            t.channels
+                .iter()
+                .map(|c| Some(c.data[i]).filter(|v| v.is_finite())),
+        );
         crate::io::number::write_row(&mut out, &mut scratch, &row)
             .with_context(|| format!("cannot write {path}"))?;
     }

@@ -164,6 +164,17 @@ fn covariance(
     file: &str,
     c: &serde_json::Map<String, Value>,
 ) -> anyhow::Result<ParameterCovariance> {
+    let (names, matrix) = covariance_arrays(file, c)?;
+    ParameterCovariance::new(names, matrix).map_err(|e| anyhow!("{file}: field `covariance`: {e}"))
+}
+
+/// The `names` and `matrix` of a summary's `covariance` object (a JSON `null` entry:
+/// infinite), checked for types only; shared with the finite-element summary
+/// ([`super::fe_summary`]).
+pub(crate) fn covariance_arrays(
+    file: &str,
+    c: &serde_json::Map<String, Value>,
+) -> anyhow::Result<(Vec<String>, Vec<Vec<f64>>)> {
     let names = c
         .get("names")
         .ok_or_else(|| anyhow!("{file}: missing field `covariance.names`"))?
@@ -200,7 +211,7 @@ fn covariance(
         }
         matrix.push(out);
     }
-    ParameterCovariance::new(names, matrix).map_err(|e| anyhow!("{file}: field `covariance`: {e}"))
+    Ok((names, matrix))
 }
 
 #[cfg(test)]

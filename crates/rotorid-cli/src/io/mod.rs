@@ -8,6 +8,7 @@
 //! | estimates CSV `t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z,window` | [`estimates_csv`] | identify | plot |
 //! | summary JSON: the serialised `rotorid::pipeline::Identification` (docs/summary.md) | - | identify | scripts |
 //! | summary JSON: identified `rotor`, `covariance` | [`identified`] | identify | analyze, balance |
+//! | summary JSON of a finite-element identification: `parameters`, `covariance`, `initial_state` | [`fe_summary`] | identify | analyze, predict |
 //!
 //! The CSV machinery (line numbering and caps, header names and units, number parsing and
 //! formatting, the response reader) is the `rotorid-io` crate's, shared with the Python
@@ -20,6 +21,7 @@
 pub use rotorid_io::csv::{columns, error as csv_error, lines, number};
 
 pub mod estimates_csv;
+pub mod fe_summary;
 pub mod finite_element;
 pub mod identified;
 pub mod message;

@@ -159,7 +159,10 @@ fn analyze_names_what_is_wrong() {
         .arg(dir.path().join("c"))
         .assert()
         .failure()
-        .stderr(contains("cannot be used with"));
+        // (a scenario goes with a finite-element summary only: refused by name)
+        .stderr(contains(
+            "a scenario goes with a finite-element summary only",
+        ));
     rotorid()
         .args(["analyze", "--scenario"])
         .arg(data("known_only.toml"))

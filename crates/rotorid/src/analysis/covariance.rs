@@ -255,41 +255,7 @@ impl ParameterCovariance {
             }
             params.push(p);
         }
-        let n = names.len();
-        if matrix.len() != n {
-            return Err(AnalysisError::NotSquare {
-                row: matrix.len(),
-                len: matrix.len(),
-                expected: n,
-            });
-        }
-        if let Some((row, r)) = matrix.iter().enumerate().find(|(_, r)| r.len() != n) {
-            return Err(AnalysisError::NotSquare {
-                row,
-                len: r.len(),
-                expected: n,
-            });
-        }
-        // undetermined: a non-finite variance; and, conservatively, both parameters of a
-        // non-finite covariance between two finite variances
-        let mut undetermined: Vec<bool> = (0..n).map(|i| !matrix[i][i].is_finite()).collect();
-        for i in 0..n {
-            for j in 0..n {
-                if !matrix[i][j].is_finite() && !undetermined[i] && !undetermined[j] {
-                    undetermined[i] = true;
-                    undetermined[j] = true;
-                }
-            }
-        }
-        for i in 0..n {
-            if !undetermined[i] && matrix[i][i] < 0.0 {
-                return Err(AnalysisError::NegativeVariance {
-                    name: names[i].clone(),
-                    value: matrix[i][i],
-                });
-            }
-        }
-        check_semidefinite(&names, &matrix, &undetermined)?;
+        let undetermined = validate_matrix(&names, &matrix)?;
         Ok(Self {
             names,
             matrix,
@@ -383,6 +349,51 @@ impl ParameterCovariance {
 /// covariance (or when undetermined).
 pub(crate) fn std_of(cov: Option<&ParameterCovariance>, g: &Gradient) -> Option<f64> {
     cov.and_then(|c| c.propagate(g))
+}
+
+/// The checks every covariance passes, whatever names its parameters (module doc): square
+/// with one row and one column per name, a non-negative variance for every determined
+/// parameter, symmetric and positive semi-definite over the determined ones. Returns, per
+/// row, whether the parameter is undetermined (a non-finite variance; and, conservatively,
+/// both parameters of a non-finite covariance between two finite variances).
+pub(crate) fn validate_matrix(
+    names: &[String],
+    matrix: &[Vec<f64>],
+) -> Result<Vec<bool>, AnalysisError> {
+    let n = names.len();
+    if matrix.len() != n {
+        return Err(AnalysisError::NotSquare {
+            row: matrix.len(),
+            len: matrix.len(),
+            expected: n,
+        });
+    }
+    if let Some((row, r)) = matrix.iter().enumerate().find(|(_, r)| r.len() != n) {
+        return Err(AnalysisError::NotSquare {
+            row,
+            len: r.len(),
+            expected: n,
+        });
+    }
+    let mut undetermined: Vec<bool> = (0..n).map(|i| !matrix[i][i].is_finite()).collect();
+    for i in 0..n {
+        for j in 0..n {
+            if !matrix[i][j].is_finite() && !undetermined[i] && !undetermined[j] {
+                undetermined[i] = true;
+                undetermined[j] = true;
+            }
+        }
+    }
+    for i in 0..n {
+        if !undetermined[i] && matrix[i][i] < 0.0 {
+            return Err(AnalysisError::NegativeVariance {
+                name: names[i].clone(),
+                value: matrix[i][i],
+            });
+        }
+    }
+    check_semidefinite(names, matrix, &undetermined)?;
+    Ok(undetermined)
 }
 
 /// Relative tolerance of the symmetry and semi-definiteness checks (rounding of a

@@ -16,6 +16,10 @@ pub enum AnalysisError {
     /// An input of balancing that cannot be used (a run, sensor, plane, speed or option).
     #[error(transparent)]
     Balance(#[from] super::balance::BalanceError),
+    /// A finite-element rotor's parameter or degree of freedom that is not the rotor's (e.g.
+    /// a covariance naming `bearing3.kxx` on a rotor of two bearings).
+    #[error(transparent)]
+    FiniteElement(#[from] crate::model::finite_element::FiniteElementError),
     /// A covariance names a parameter the analysis does not know.
     #[error("unknown parameter {name:?} in the covariance: expected names from {allowed}")]
     UnknownParameter {

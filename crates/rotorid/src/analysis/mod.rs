@@ -35,6 +35,9 @@
 //!   corrections' uncertainty, their split into holes and trial-weight planning.
 //! - `one_x`: the 1X vector of a sampled signal against the shaft angle.
 //! - `covariance`: [`ParameterCovariance`] and the delta method.
+//! - `finite_element`: the same for a finite-element rotor ([`fe_analysis`]: Campbell
+//!   diagram of its lowest modes followed across speeds, critical speeds, stability;
+//!   [`fe_unbalances`]; [`FeCovariance`] over its parameters' names).
 //!
 //! Conventions, the checks against independent references and the measured figures are in
 //! `docs/analysis.md` of this repository.
@@ -56,6 +59,7 @@ pub mod balance;
 mod covariance;
 mod critical;
 mod error;
+mod finite_element;
 mod modes;
 mod one_x;
 mod response;
@@ -68,6 +72,10 @@ pub use balance::{
 pub use covariance::{CovarianceParameter, ParameterCovariance, PARAMETER_NAMES};
 pub use critical::{critical_speeds, CriticalSpeed};
 pub use error::AnalysisError;
+pub use finite_element::{
+    fe_analysis, fe_stability_margin, fe_unbalances, FeAnalysis, FeCampbell, FeCovariance,
+    FeUnbalanceEstimate,
+};
 pub use modes::{campbell, modes, Campbell, Mode, Whirl, PLANAR_WHIRL};
 pub use one_x::{one_x, synchronous_average, OneX};
 pub use response::{unbalance_response, Probe, ResponseChannel, ResponseVector, UnbalanceResponse};
