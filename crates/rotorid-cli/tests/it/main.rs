@@ -10,6 +10,7 @@ mod daqmx;
 mod dashboard;
 mod dashboard_browser;
 mod demo;
+mod fe_data;
 mod finite_element;
 mod fleet;
 mod formats;
