@@ -71,6 +71,9 @@ const CLEAN: &str = "[acquisition.simulate]\nsnr_db = inf\nbits = 0\nkp_jitter_s
     kp_noise_v = 0.0\nrunout_um = [[0.0], [0.0], [0.0], [0.0]]\n\
     gap_v = [-9.0, -10.5, 9.5, -8.0]\n";
 
+/// A CSV as (header, rows).
+type Csv = (String, Vec<Vec<f64>>);
+
 /// `rotorid ARGS`: stdout on success, else stderr as the error.
 fn run(args: &[&str]) -> Result<String, String> {
     let out = rotorid().args(args).output().unwrap();
@@ -85,10 +88,7 @@ fn run(args: &[&str]) -> Result<String, String> {
 
 /// Simulate the raw record of `toml`, condition it, and return the conditioned response
 /// and the simulated one (same columns), each as (header, rows).
-fn raw_round_trip(
-    dir: &std::path::Path,
-    toml: &str,
-) -> ((String, Vec<Vec<f64>>), (String, Vec<Vec<f64>>)) {
+fn raw_round_trip(dir: &std::path::Path, toml: &str) -> (Csv, Csv) {
     let raw = dir.join("raw.csv");
     run(&[
         "simulate",
@@ -116,7 +116,7 @@ fn raw_round_trip(
 /// Per conditioned degree of freedom (header name, column in truth): the largest
 /// deviation of (conditioned - truth) from its mean, that mean, the RMS of the deviation
 /// and the truth's amplitude and RMS.
-fn compare(cond: &(String, Vec<Vec<f64>>), truth: &(String, Vec<Vec<f64>>)) -> Vec<[f64; 5]> {
+fn compare(cond: &Csv, truth: &Csv) -> Vec<[f64; 5]> {
     let th: Vec<&str> = truth.0.split(',').collect();
     let ch: Vec<&str> = cond.0.split(',').collect();
     let n = cond.1.len() as f64;

@@ -57,6 +57,13 @@ use crate::model::finite_element::{Dof, DofKind, FeMatrices};
 
 /// Rows of numbers and the line of their key.
 type Rows = (Vec<Vec<f64>>, Option<usize>);
+/// A probe pair: its node and the line of its `node` (none for a lumped rotor), and the
+/// two probes' indices in `[[acquisition.probe]]`.
+type Pair = (Option<NodeLine>, [usize; 2]);
+/// A probe's node and the line of its `node` key.
+type NodeLine = (u32, Option<usize>);
+/// `[acquisition.simulate]`: the settings, and each probe's gap \[V\] and runout.
+type SimulateSettings = (RawSettings, Vec<f64>, Vec<Vec<RunoutHarmonic>>);
 
 /// A table in either TOML form.
 #[derive(Clone, Copy)]
@@ -443,7 +450,7 @@ impl Parser<'_> {
             });
         }
         // The pairs: the two probes of a lumped rotor, or each node's two (file indices).
-        let pairs: Vec<(Option<(u32, Option<usize>)>, [usize; 2])> = match model {
+        let pairs: Vec<Pair> = match model {
             Some(_) => vec![(None, [0, 1])],
             None => self.node_pairs(&nodes, &probes_v)?,
         };
@@ -573,7 +580,7 @@ impl Parser<'_> {
             }
         };
         Ok(match model {
-            Some(_) => Acquisitions::Lumped(pair_of([0, 1])),
+            Some(_) => Acquisitions::Lumped(Box::new(pair_of([0, 1]))),
             None => Acquisitions::FiniteElement(FeAcquisitionSpec {
                 acquisition: FeAcquisition {
                     nodes: pairs
@@ -646,12 +653,11 @@ impl Parser<'_> {
     /// The probes of a finite-element rotor grouped by node, in the order the nodes first
     /// appear: (node and the line of its first probe's `node`, the two probes' indices).
     /// A node with one probe, or more than two, is an error naming it.
-    #[allow(clippy::type_complexity)]
     fn node_pairs(
         &self,
-        nodes: &[(Option<(u32, Option<usize>)>, Option<usize>)],
+        nodes: &[(Option<NodeLine>, Option<usize>)],
         probes_v: &[Probe],
-    ) -> Result<Vec<(Option<(u32, Option<usize>)>, [usize; 2])>, ScenarioFileError> {
+    ) -> Result<Vec<Pair>, ScenarioFileError> {
         let mut groups: Vec<(u32, Option<usize>, Vec<usize>)> = Vec::new();
         for (i, (n, _)) in nodes.iter().enumerate() {
             let (node, line) = n.expect("every probe of a finite-element rotor has a node");
@@ -696,11 +702,7 @@ impl Parser<'_> {
 
     /// `[acquisition.simulate]` for `n` probes: the settings, and each probe's gap \[V\]
     /// and runout (by default the defaults of probe 1 and 2 in turn).
-    fn simulate(
-        &self,
-        e: &Entries<'_>,
-        n: usize,
-    ) -> Result<(RawSettings, Vec<f64>, Vec<Vec<RunoutHarmonic>>), ScenarioFileError> {
+    fn simulate(&self, e: &Entries<'_>, n: usize) -> Result<SimulateSettings, ScenarioFileError> {
         let mut s = RawSettings::default();
         let fin = |v: f64| v.is_finite();
         let pair = |k: &str, allowed: &str| -> Result<Option<[f64; 2]>, ScenarioFileError> {
@@ -916,7 +918,7 @@ fn per_probe_defaults(n: usize) -> (Vec<f64>, Vec<Vec<RunoutHarmonic>>) {
 }
 
 /// [`RawSettings::default`] for `n` probes ([`per_probe_defaults`]).
-fn default_simulate(n: usize) -> (RawSettings, Vec<f64>, Vec<Vec<RunoutHarmonic>>) {
+fn default_simulate(n: usize) -> SimulateSettings {
     let (gaps, runouts) = per_probe_defaults(n);
     (RawSettings::default(), gaps, runouts)
 }
@@ -926,7 +928,7 @@ fn default_simulate(n: usize) -> (RawSettings, Vec<f64>, Vec<Vec<RunoutHarmonic>
 #[derive(Debug, Clone, PartialEq)]
 pub(super) enum Acquisitions {
     /// `jeffcott`, `cross_coupled`.
-    Lumped(Acquisition),
+    Lumped(Box<Acquisition>),
     /// `finite_element`.
     FiniteElement(FeAcquisitionSpec),
 }

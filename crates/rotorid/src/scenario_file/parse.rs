@@ -164,7 +164,7 @@ impl Parser<'_> {
         let (acquisition, fe_acquisition) = match acquisition {
             None => (None, None),
             Some((item, line)) => match self.acquisition(item, line, model)? {
-                Acquisitions::Lumped(a) => (Some(a), None),
+                Acquisitions::Lumped(a) => (Some(*a), None),
                 Acquisitions::FiniteElement(a) => (None, Some(a)),
             },
         };
