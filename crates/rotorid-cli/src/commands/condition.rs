@@ -39,6 +39,9 @@ pub fn run(args: ConditionArgs) -> anyhow::Result<()> {
         &[("--out", &args.out)],
     )?;
     let spec = ScenarioSpec::load(&args.scenario)?;
+    if spec.finite_element().is_some() {
+        return condition_finite_element(&args, &spec);
+    }
     let Some(acq) = spec.acquisition() else {
         anyhow::bail!(
             "{}: has no [acquisition] table: it names the probe and keyphasor columns (see \
@@ -70,4 +73,40 @@ pub fn run(args: ConditionArgs) -> anyhow::Result<()> {
             .with_context(|| format!("cannot write {name}"))?;
     }
     w.into_inner().commit()
+}
+
+/// A finite-element scenario: every measured node's two probes conditioned by the 2-DOF
+/// conditioning (`rotorid::acquisition::condition_fe_raw`, docs/acquisition.md section 11),
+/// written as the response file of a finite-element rotor (`t`, `<node>.x`, `<node>.y`
+/// ..., `phi`, `phi_dot`, `phi_ddot`; CSV or a binary format by the extension); the report
+/// holds one conditioning report per node.
+fn condition_finite_element(args: &ConditionArgs, spec: &ScenarioSpec) -> anyhow::Result<()> {
+    let rotor = crate::io::finite_element::finite_element_of(spec)?;
+    let Some(acq) = crate::io::finite_element::fe_acquisition_of(spec, &rotor)? else {
+        anyhow::bail!(
+            "{}: has no [acquisition] table: it names the probe columns (two per measured \
+             node, [[acquisition.probe]] node = N) and the keyphasor (see docs/acquisition.md)",
+            spec.origin()
+        );
+    };
+    let table = tables::read(&args.input)?;
+    let raw = tables::fe_raw_record(&table, acq)?;
+    let slow = tables::fe_slow_roll(spec, acq)?;
+    let c = rotorid::acquisition::condition_fe_raw(&raw, acq, slow.as_ref())?;
+    for (node, report) in &c.reports {
+        for n in &report.notes {
+            eprintln!("note: node {node}: {n}");
+        }
+        for f in &report.findings {
+            eprintln!("warning: node {node}: {}", f.message());
+        }
+    }
+    if let Some(path) = &args.report {
+        let mut f = Output::create(path, FileMode::Atomic)?;
+        serde_json::to_writer_pretty(&mut f, &c.reports)
+            .with_context(|| format!("cannot write {path}"))?;
+        f.commit()?;
+    }
+    let table = crate::io::fe_response::fe_table(&args.out, c.response);
+    crate::commands::simulate::write_any(&args.out, &table)
 }

@@ -14,6 +14,12 @@ pub struct InspectArgs {
     /// of a finite-element rotor.
     #[arg(value_name = "FILE")]
     pub file: String,
+
+    /// A finite-element scenario: FILE is read as the response file of its rotor
+    /// (docs/formats.md: t, the measured <node>.<dof> columns, phi, phi_dot, phi_ddot or
+    /// the scenario's [speed]) with every check identification makes, and summarised.
+    #[arg(long, value_name = "FE.toml")]
+    pub scenario: Option<String>,
 }
 
 /// What `inspect` prints of one channel.
@@ -64,6 +70,9 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
     let toml = std::path::Path::new(&args.file)
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if let Some(scenario) = &args.scenario {
+        return fe_response(&args.file, scenario);
+    }
     if toml {
         return finite_element(&args.file);
     }
@@ -224,6 +233,46 @@ fn extremes(data: &[f64]) -> (f64, f64, usize) {
         hi.into_iter().fold(f64::NEG_INFINITY, f64::max),
         nan.into_iter().sum(),
     )
+}
+
+/// `rotorid inspect FILE --scenario fe.toml`: FILE read as the response file of the
+/// scenario's finite-element rotor (`crate::io::fe_response::read_fe_response`), one line
+/// for the record and one per measured degree of freedom.
+fn fe_response(path: &str, scenario: &str) -> anyhow::Result<()> {
+    use crate::io::LoadScenario as _;
+    let spec = crate::io::ScenarioSpec::load(scenario)?;
+    let rotor = crate::io::finite_element::finite_element_of(&spec)?;
+    let r = crate::io::fe_response::read_fe_response(
+        path,
+        &rotor,
+        spec.speed_profile(),
+        rotorid::pipeline::DEFAULT_TIME_TOLERANCE,
+    )?;
+    let n = r.len();
+    let grid = rotorid::pipeline::TimeGrid::fit(&r.t, rotorid::pipeline::DEFAULT_TIME_TOLERANCE)?;
+    let (lo, hi, _) = extremes(&r.phi_dot);
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{path}: response of the finite-element rotor of {scenario}: {} measured degrees of \
+         freedom, {n} samples, dt = {:e} s, t = {:e} .. {:e} s, phi_dot = {lo:e} .. {hi:e} rad/s",
+        r.dofs.len(),
+        grid.dt,
+        r.t[0],
+        r.t[n - 1],
+    );
+    for (d, q) in r.dofs.iter().zip(&r.q) {
+        let (lo, hi, _) = extremes(q);
+        let rms = (q.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
+        let _ = writeln!(
+            out,
+            "  {:<8} [{}]  min {lo:e}  max {hi:e}  RMS {rms:e}",
+            d.to_string(),
+            d.kind.unit()
+        );
+    }
+    print!("{out}");
+    Ok(())
 }
 
 /// `rotorid inspect fe.toml`: the finite-element rotor of a scenario, as its matrices file

@@ -287,12 +287,6 @@ fn simulate_finite_element(args: &SimulateArgs, spec: &ScenarioSpec) -> anyhow::
             spec.origin()
         );
     }
-    if args.raw {
-        anyhow::bail!(
-            "--raw: the raw acquisition of a finite-element rotor is not built yet (probes at \
-             nodes); simulate its response instead"
-        );
-    }
     let rotor = crate::io::finite_element::finite_element_of(spec)?;
     let (speed, sampling) = spec.fe_simulation(&SimulationOverrides {
         dt: args.dt,
@@ -305,55 +299,26 @@ fn simulate_finite_element(args: &SimulateArgs, spec: &ScenarioSpec) -> anyhow::
         (MethodArg::Exact, _) => FeMethod::Magnus,
     };
     let system = FeSystem::full(&rotor);
-    let r = simulate_fe(&system, &speed, &sampling, None, None, method)?;
-    let header = r.header();
-    let mut channels: Vec<rotorid_io::Channel> = Vec::with_capacity(header.len());
-    let unit = |name: &str| match name {
-        "t" => "s",
-        "phi" => "rad",
-        "phi_dot" => "rad/s",
-        "phi_ddot" => "rad/s^2",
-        _ if name.ends_with(".rx") || name.ends_with(".ry") => "rad",
-        _ => "m",
-    };
-    let mut q = r.q;
+    if args.raw {
+        return write_fe_raw(args, spec, &rotor, &system, (&speed, &sampling), method);
+    }
+    let mut r = simulate_fe(&system, &speed, &sampling, None, None, method)?;
     if let Some(snr_db) = args.snr_db {
         let seed = args.seed.unwrap_or(0);
-        let mut cols: Vec<(&'static str, &mut [f64])> = q
-            .iter_mut()
-            .map(|c| ("finite-element response", &mut c[..]))
-            .collect();
+        let mut cols: Vec<(&'static str, &mut [f64])> =
+            r.q.iter_mut()
+                .map(|c| ("finite-element response", &mut c[..]))
+                .collect();
         let sigmas = rotorid::simulate::add_noise_to(&mut cols, snr_db, seed)?;
         if !args.quiet {
-            let each: Vec<String> = r
-                .dofs
-                .iter()
-                .zip(&sigmas)
-                .map(|(d, s)| format!("{d} {s:e} {}", d.kind.unit()))
-                .collect();
             eprintln!(
                 "added white noise at SNR {snr_db} dB (seed {seed}) to every degree of \
                  freedom: sigma {}",
-                each.join(", ")
+                sigma_list(&r.dofs, &sigmas)
             );
         }
     }
-    let mut data = vec![r.t];
-    data.extend(q);
-    data.extend([r.phi, r.phi_dot, r.phi_ddot]);
-    for (name, data) in header.into_iter().zip(data) {
-        channels.push(rotorid_io::Channel {
-            unit: Some(unit(&name).to_owned()),
-            name,
-            data,
-            axis: None,
-        });
-    }
-    let table = rotorid_io::Table {
-        file: args.out.clone(),
-        notes: Vec::new(),
-        channels,
-    };
+    let table = crate::io::fe_response::fe_table(&args.out, r);
     if !args.quiet {
         eprintln!(
             "simulated the finite-element rotor of {} ({} degrees of freedom, {} bearings, \
@@ -368,6 +333,53 @@ fn simulate_finite_element(args: &SimulateArgs, spec: &ScenarioSpec) -> anyhow::
         Err(e) if args.out == "-" && is_broken_pipe(&e) => Ok(()),
         r => r,
     }
+}
+
+/// `dof sigma unit, ...` for the noise message.
+fn sigma_list(dofs: &[rotorid::model::finite_element::Dof], sigmas: &[f64]) -> String {
+    let each: Vec<String> = dofs
+        .iter()
+        .zip(sigmas)
+        .map(|(d, s)| format!("{d} {s:e} {}", d.kind.unit()))
+        .collect();
+    each.join(", ")
+}
+
+/// `--raw` of a finite-element scenario: the probes' volts at their nodes (two per node,
+/// `[[acquisition.probe]] node = N`) and the keyphasor, from the full model's response at
+/// the measured nodes (`rotorid::acquisition::simulate_fe_raw`, docs/acquisition.md
+/// section 11). No slow-roll record.
+fn write_fe_raw(
+    args: &SimulateArgs,
+    spec: &ScenarioSpec,
+    rotor: &rotorid::model::finite_element::FiniteElementRotor,
+    system: &rotorid::model::finite_element::FeSystem,
+    (speed, sampling): (&rotorid::SpeedProfile, &rotorid::Sampling),
+    method: rotorid::simulate::finite_element::FeMethod,
+) -> anyhow::Result<()> {
+    let Some(acq) = crate::io::finite_element::fe_acquisition_of(spec, rotor)? else {
+        anyhow::bail!(
+            "--raw needs an [acquisition] table in the scenario {} (two [[acquisition.probe]] \
+             per measured node, each with node = N, and a keyphasor; see docs/acquisition.md)",
+            spec.origin()
+        );
+    };
+    if args.slow_roll_out.is_some() {
+        anyhow::bail!(
+            "--slow-roll-out: the slow-roll record of a finite-element rotor is not simulated \
+             (the running record is: drop --slow-roll-out)"
+        );
+    }
+    let sim = rotorid::acquisition::simulate_fe_raw(system, speed, sampling, acq, method)?;
+    if !args.quiet {
+        eprintln!(
+            "raw acquisition of the finite-element rotor of {} by {method}: noise sigma {} on \
+             the displacements",
+            spec.origin(),
+            sigma_list(&sim.truth.dofs, &sim.sigma)
+        );
+    }
+    write_any(&args.out, &raw_table(&args.out, sim.running))
 }
 
 /// `--raw`: the raw acquisition of the scenario's [acquisition] (and its slow roll).

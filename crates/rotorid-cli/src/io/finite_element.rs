@@ -55,6 +55,22 @@ pub fn finite_element_of(spec: &ScenarioSpec) -> anyhow::Result<FiniteElementRot
     Ok(fe.rotor(Arc::new(matrices), &file)?)
 }
 
+/// The `[acquisition]` of the finite-element scenario `spec` (two probes per measured
+/// node), each probe's node checked against `rotor`'s matrices (the file named in the
+/// message); `None` when the scenario has no `[acquisition]`.
+pub fn fe_acquisition_of<'a>(
+    spec: &'a ScenarioSpec,
+    rotor: &FiniteElementRotor,
+) -> anyhow::Result<Option<&'a rotorid::acquisition::FeAcquisition>> {
+    let (Some(acq), Some(fe)) = (spec.fe_acquisition(), spec.finite_element()) else {
+        return Ok(None);
+    };
+    let file = matrices_path(spec.origin(), &fe.matrices)
+        .display()
+        .to_string();
+    Ok(Some(acq.checked(&rotor.matrices, &file)?))
+}
+
 /// The finite-element rotor of the scenario file at `toml_path` ([`finite_element_of`]).
 pub fn load_finite_element(toml_path: &str) -> anyhow::Result<FiniteElementRotor> {
     finite_element_of(&ScenarioSpec::load(toml_path)?)

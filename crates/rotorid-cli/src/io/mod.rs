@@ -4,6 +4,7 @@
 //! |---|---|---|---|
 //! | scenario TOML (rotor, speed, sampling, initial state; SI) | [`scenario`] | you | simulate, identify |
 //! | finite-element matrices NPZ `M`, `K`, `G`, `C`, `Ka`, `dofs` (beside the scenario) | [`finite_element`] | you, `rotorid.ross.export` | inspect |
+//! | finite-element response `t,<node>.<dof>...,phi,phi_dot,phi_ddot` (CSV or binary) | [`fe_response`] | simulate | the finite-element refine |
 //! | response CSV `t,x,z,phi,phi_dot,phi_ddot` (s, m, m, rad, rad/s, rad/s^2) | [`response_csv`] | simulate | identify, plot |
 //! | estimates CSV `t,m_x,c_x,k_x,m_z,c_z,k_z,rcond_x,rcond_z,window` | [`estimates_csv`] | identify | plot |
 //! | summary JSON: the serialised `rotorid::pipeline::Identification` (docs/summary.md) | - | identify | scripts |
@@ -22,6 +23,7 @@ pub use rotorid_io::csv::{columns, error as csv_error, lines, number};
 
 pub mod estimates_csv;
 pub mod fe_summary;
+pub mod fe_response;
 pub mod finite_element;
 pub mod identified;
 pub mod message;

@@ -7,8 +7,8 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use rotorid::acquisition::{
-    condition, condition_iterated, Acquisition, Conditioned, GuessSource, ModelGuess, RawRecord,
-    TimeBase,
+    condition, condition_iterated, Acquisition, Conditioned, FeAcquisition, GuessSource,
+    ModelGuess, RawRecord, TimeBase,
 };
 use rotorid::pipeline::{Knowledge, Method};
 use rotorid::scenario_file::ScenarioSpec;
@@ -99,10 +99,35 @@ fn print_selection(file: &str, used: &[rotorid_io::select::Used], time_from_axis
 /// Without a time channel, a file's time axis (TDMS `wf_increment`, a UFF58 abscissa) on
 /// the first probe gives it, t_i = start + i increment, with a note on stderr.
 pub fn raw_record(table: &Table, acq: &Acquisition) -> anyhow::Result<RawRecord> {
-    let roles: Vec<(&str, &str, Option<&str>)> = acq
-        .columns()
-        .into_iter()
-        .map(|(n, what)| (n, what, table.channel(n).map(|c| c.name.as_str())))
+    raw_record_of(table, &acq.columns(), &acq.time, &acq.probes[0].column)
+}
+
+/// [`raw_record`] for the raw record of a finite-element rotor: the columns of every
+/// node's probes (docs/acquisition.md section 11), the time and the keyphasor once.
+pub fn fe_raw_record(table: &Table, acq: &FeAcquisition) -> anyhow::Result<RawRecord> {
+    let common = acq.common()?;
+    let mut roles: Vec<(&str, &'static str)> = Vec::new();
+    for n in &acq.nodes {
+        for r in n.acquisition.columns() {
+            if !roles.iter().any(|(c, _)| *c == r.0) {
+                roles.push(r);
+            }
+        }
+    }
+    raw_record_of(table, &roles, &common.time, &common.probes[0].column)
+}
+
+/// The raw record of `table` whose channels `roles` (column, role) are converted to SI; a
+/// time from the time axis of `first_probe` when `time` names no channel of the table.
+fn raw_record_of(
+    table: &Table,
+    roles: &[(&str, &'static str)],
+    time: &TimeBase,
+    first_probe: &str,
+) -> anyhow::Result<RawRecord> {
+    let roles: Vec<(&str, &str, Option<&str>)> = roles
+        .iter()
+        .map(|&(n, what)| (n, what, table.channel(n).map(|c| c.name.as_str())))
         .collect();
     let mut columns = Vec::with_capacity(table.channels.len() + 1);
     for c in &table.channels {
@@ -126,8 +151,8 @@ pub fn raw_record(table: &Table, acq: &Acquisition) -> anyhow::Result<RawRecord>
         };
         columns.push((name, data));
     }
-    if let TimeBase::Column(t) = &acq.time {
-        let probe = table.channel(&acq.probes[0].column);
+    if let TimeBase::Column(t) = time {
+        let probe = table.channel(first_probe);
         if let (None, Some(axis), Some(probe)) =
             (table.channel(t), probe.and_then(|p| p.axis), probe)
         {
@@ -143,6 +168,21 @@ pub fn raw_record(table: &Table, acq: &Acquisition) -> anyhow::Result<RawRecord>
 
 /// The slow-roll record of `acq`, read from its path relative to the scenario file.
 pub fn slow_roll(spec: &ScenarioSpec, acq: &Acquisition) -> anyhow::Result<Option<RawRecord>> {
+    slow_roll_table(spec, acq)?
+        .map(|t| raw_record(&t, acq))
+        .transpose()
+}
+
+/// [`slow_roll`] of a finite-element rotor: every node's probes ([`fe_raw_record`]).
+pub fn fe_slow_roll(spec: &ScenarioSpec, acq: &FeAcquisition) -> anyhow::Result<Option<RawRecord>> {
+    slow_roll_table(spec, acq.common()?)?
+        .map(|t| fe_raw_record(&t, acq))
+        .transpose()
+}
+
+/// The table of the slow-roll file of `acq`, read from its path relative to the scenario
+/// file, when it has one.
+fn slow_roll_table(spec: &ScenarioSpec, acq: &Acquisition) -> anyhow::Result<Option<Table>> {
     let Some(rel) = &acq.slow_roll else {
         return Ok(None);
     };
@@ -150,7 +190,7 @@ pub fn slow_roll(spec: &ScenarioSpec, acq: &Acquisition) -> anyhow::Result<Optio
     let path = base.join(rel);
     let table = read(&path.to_string_lossy())
         .with_context(|| format!("the slow-roll record of [acquisition.runout] ({rel})"))?;
-    Ok(Some(raw_record(&table, acq)?))
+    Ok(Some(table))
 }
 
 /// The scenario's rotor as a guess for the conditioning, when its `[rotor]` is complete

@@ -38,7 +38,7 @@ fn speed(ramp: bool) -> &'static str {
 }
 
 /// The same rotor as a finite-element scenario and as a cross-coupled one.
-fn scenarios(dir: &std::path::Path, ramp: bool) -> (String, String) {
+pub(crate) fn scenarios(dir: &std::path::Path, ramp: bool) -> (String, String) {
     matrices(dir);
     let fe = dir.join(format!("fe{ramp}.toml"));
     std::fs::write(
@@ -69,7 +69,7 @@ fn scenarios(dir: &std::path::Path, ramp: bool) -> (String, String) {
     )
 }
 
-fn columns(csv: &str) -> (String, Vec<Vec<f64>>) {
+pub(crate) fn columns(csv: &str) -> (String, Vec<Vec<f64>>) {
     let mut lines = csv.lines();
     let header = lines.next().unwrap().to_owned();
     let rows: Vec<Vec<f64>> = lines

@@ -11,6 +11,7 @@ mod dashboard;
 mod dashboard_browser;
 mod demo;
 mod fe_analyze;
+mod fe_data;
 mod finite_element;
 mod fleet;
 mod formats;

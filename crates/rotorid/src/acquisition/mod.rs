@@ -33,6 +33,7 @@
 //! (whose path `[acquisition.runout] slow_roll` names) into [`RawRecord`]s.
 
 mod error;
+pub mod finite_element;
 mod iterate;
 pub mod keyphasor;
 pub mod model_fit;
@@ -43,6 +44,9 @@ pub mod runout;
 use serde::Serialize;
 
 pub use error::{AcquisitionError, Which};
+pub use finite_element::{
+    condition_fe_raw, simulate_fe_raw, FeAcquisition, FeConditioned, FeNodeProbes, FeRawSimulation,
+};
 pub use iterate::{
     change, condition_iterated, ChangeBasis, Iterated, IterationError, Passes, MAX_PASSES,
     SETTLED_RELATIVE, SETTLED_STD_ERRORS,

@@ -33,6 +33,10 @@ use super::error::AcquisitionError;
 use super::probes::toward;
 use super::{Acquisition, Edge, RawRecord, TimeBase};
 
+/// What is added to `[acquisition.simulate] seed` to seed the keyphasor's draws (jitter,
+/// noise).
+pub(super) const KEYPHASOR_SEED: u64 = 0x5eed_0001;
+
 /// One runout harmonic: A cos(h phi + p).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct RunoutHarmonic {
@@ -236,14 +240,14 @@ fn smooth_step(y: f64) -> f64 {
 }
 
 /// Quantiser of the module doc (identity without bits).
-struct Adc {
+pub(super) struct Adc {
     lo: f64,
     q: f64,
     top: f64,
 }
 
 impl Adc {
-    fn new(s: &RawSettings) -> Option<Self> {
+    pub(super) fn new(s: &RawSettings) -> Option<Self> {
         let b = s.bits?;
         let [lo, hi] = s.range_v;
         let q = (hi - lo) / 2f64.powi(b as i32);
@@ -267,31 +271,61 @@ fn channels(
     resp: &TimeResponse,
     rng: &mut ChaCha8Rng,
 ) -> RawRecord {
-    let n = x.len();
     let adc = Adc::new(s);
-    let quant = |v: f64| adc.as_ref().map_or(v, |a| a.apply(v));
     let mut cols = Vec::new();
     if let TimeBase::Column(c) = &acq.time {
         cols.push((c.clone(), resp.t.clone()));
     }
     for k in 0..2 {
         let p = &acq.probes[k];
-        let v: Vec<f64> = (0..n)
-            .map(|i| {
-                let r: f64 = s.runout[k]
-                    .iter()
-                    .map(|h| h.amplitude * (h.harmonic as f64 * resp.phi[i] + h.phase).cos())
-                    .sum();
-                quant(s.gap_v[k] + p.sensitivity * (toward(p.angle, x[i], z[i]) + r))
-            })
-            .collect();
+        let v = probe_volts(p, s.gap_v[k], &s.runout[k], adc.as_ref(), x, z, &resp.phi);
         cols.push((p.column.clone(), v));
     }
-    // Keyphasor: one jitter draw per revolution.
+    let kp = keyphasor_volts(acq, s, adc.as_ref(), &resp.phi, &resp.phi_dot, rng);
+    cols.push((acq.keyphasor.column.clone(), kp));
+    RawRecord { columns: cols }
+}
+
+/// The volts of probe `p` (gap `gap_v`, runout `runout`, quantised by `adc` when given)
+/// for the shaft at (x, z) at angle phi, sample by sample:
+/// `gap_v + s (x cos t + z sin t + r(phi))`.
+pub(super) fn probe_volts(
+    p: &super::Probe,
+    gap_v: f64,
+    runout: &[RunoutHarmonic],
+    adc: Option<&Adc>,
+    x: &[f64],
+    z: &[f64],
+    phi: &[f64],
+) -> Vec<f64> {
+    let quant = |v: f64| adc.map_or(v, |a| a.apply(v));
+    (0..x.len())
+        .map(|i| {
+            let r: f64 = runout
+                .iter()
+                .map(|h| h.amplitude * (h.harmonic as f64 * phi[i] + h.phase).cos())
+                .sum();
+            quant(gap_v + p.sensitivity * (toward(p.angle, x[i], z[i]) + r))
+        })
+        .collect()
+}
+
+/// The keyphasor's volts for the shaft angle `phi` and speed `phi_dot` (module doc): one
+/// jitter draw per revolution from `rng`, then one noise draw per sample.
+pub(super) fn keyphasor_volts(
+    acq: &Acquisition,
+    s: &RawSettings,
+    adc: Option<&Adc>,
+    phi: &[f64],
+    phi_dot: &[f64],
+    rng: &mut ChaCha8Rng,
+) -> Vec<f64> {
+    let n = phi.len();
+    let quant = |v: f64| adc.map_or(v, |a| a.apply(v));
     let phi_kp = acq.keyphasor.angle;
     let rev = |phi: f64| ((phi - phi_kp) / (2.0 * PI) + 0.5).floor() as i64;
-    let r0 = rev(resp.phi[0]) - 1;
-    let r1 = rev(resp.phi[n - 1]) + 1;
+    let r0 = rev(phi[0]) - 1;
+    let r1 = rev(phi[n - 1]) + 1;
     let jitter: Vec<f64> = (r0..=r1)
         .map(|_| s.kp_jitter_s * rng.sample::<f64, _>(StandardNormal))
         .collect();
@@ -299,11 +333,11 @@ fn channels(
         Edge::Falling => -1.0,
         Edge::Rising => 1.0,
     };
-    let kp: Vec<f64> = (0..n)
+    (0..n)
         .map(|i| {
-            let psi = resp.phi[i] - phi_kp;
-            let r = rev(resp.phi[i]);
-            let u = psi - 2.0 * PI * r as f64 - resp.phi_dot[i] * jitter[(r - r0) as usize];
+            let psi = phi[i] - phi_kp;
+            let r = rev(phi[i]);
+            let u = psi - 2.0 * PI * r as f64 - phi_dot[i] * jitter[(r - r0) as usize];
             let g = if s.kp_edge > 0.0 {
                 smooth_step(u / s.kp_edge) * (1.0 - smooth_step((u - s.kp_width) / s.kp_edge))
             } else if (0.0..s.kp_width).contains(&u) {
@@ -314,9 +348,7 @@ fn channels(
             let noise: f64 = rng.sample(StandardNormal);
             quant(s.kp_baseline_v + sign * s.kp_depth_v * g + s.kp_noise_v * noise)
         })
-        .collect();
-    cols.push((acq.keyphasor.column.clone(), kp));
-    RawRecord { columns: cols }
+        .collect()
 }
 
 /// Simulate a raw acquisition of `scenario` (exact simulation, docs/method.md section 2)
@@ -351,7 +383,7 @@ pub fn simulate_raw(
             sigma_z: 0.0,
         },
     };
-    let mut rng = ChaCha8Rng::seed_from_u64(s.seed.wrapping_add(0x5eed_0001));
+    let mut rng = ChaCha8Rng::seed_from_u64(s.seed.wrapping_add(KEYPHASOR_SEED));
     let running = channels(acq, s, &noisy.x, &noisy.z, &truth, &mut rng);
     let (slow_roll, slow_roll_truth) = if s.slow_roll_rpm > 0.0 {
         let speed = SpeedProfile::constant_rpm(s.slow_roll_rpm, 0.3)?;

@@ -50,12 +50,20 @@ use toml_edit::{InlineTable, Item, Key, Table, Value};
 use super::parse::Parser;
 use super::ScenarioFileError;
 use crate::acquisition::{
-    probes, Acquisition, Edge, Keyphasor, Probe, RawSettings, RunoutHarmonic, Threshold, TimeBase,
-    DEFAULT_RUNOUT_HARMONICS, METRES_PER_MIL,
+    probes, Acquisition, Edge, FeAcquisition, FeNodeProbes, Keyphasor, Probe, RawSettings,
+    RunoutHarmonic, Threshold, TimeBase, DEFAULT_RUNOUT_HARMONICS, METRES_PER_MIL,
 };
+use crate::model::finite_element::{Dof, DofKind, FeMatrices};
 
 /// Rows of numbers and the line of their key.
 type Rows = (Vec<Vec<f64>>, Option<usize>);
+/// A probe pair: its node and the line of its `node` (none for a lumped rotor), and the
+/// two probes' indices in `[[acquisition.probe]]`.
+type Pair = (Option<NodeLine>, [usize; 2]);
+/// A probe's node and the line of its `node` key.
+type NodeLine = (u32, Option<usize>);
+/// `[acquisition.simulate]`: the settings, and each probe's gap \[V\] and runout.
+type SimulateSettings = (RawSettings, Vec<f64>, Vec<Vec<RunoutHarmonic>>);
 
 /// A table in either TOML form.
 #[derive(Clone, Copy)]
@@ -116,11 +124,12 @@ const TOP: [&str; 6] = [
     "runout",
     "simulate",
 ];
-const PROBE: [&str; 4] = [
+const PROBE: [&str; 5] = [
     "column",
     "angle_deg",
     "sensitivity",
     "sensitivity_mv_per_mil",
+    "node",
 ];
 const KEYPHASOR: [&str; 4] = ["column", "edge", "threshold", "angle_deg"];
 const RUNOUT: [&str; 2] = ["slow_roll", "harmonics"];
@@ -344,12 +353,14 @@ impl Parser<'_> {
         }
     }
 
-    /// `[acquisition]` (module doc).
+    /// `[acquisition]` (module doc) of a rotor of model `model` (`None`: a
+    /// finite-element rotor, whose probes each name a node, two per node).
     pub(super) fn acquisition(
         &self,
         item: &Item,
         line: Option<usize>,
-    ) -> Result<Acquisition, ScenarioFileError> {
+        model: Option<crate::parameter::ModelKind>,
+    ) -> Result<Acquisitions, ScenarioFileError> {
         let node = self.table_of("acquisition", line, Val::Item(item))?;
         let top = self.entries("acquisition", line, node, &TOP)?;
         let time = match (self.string(&top, "time")?, top.get("rate_hz")) {
@@ -380,7 +391,7 @@ impl Parser<'_> {
             ));
         };
         let tables = self.array_of_tables("acquisition.probe", pl, pv)?;
-        if tables.len() != 2 {
+        if tables.len() != 2 && model.is_some() {
             return Err(ScenarioFileError::Inconsistent {
                 origin: self.origin.to_owned(),
                 line: pl,
@@ -392,8 +403,11 @@ impl Parser<'_> {
         }
         let mut probes_v = Vec::new();
         let mut angle_lines = Vec::new();
-        for (node, l) in tables {
+        let mut nodes = Vec::new();
+        for (i, (node, l)) in tables.into_iter().enumerate() {
             let e = self.entries("acquisition.probe", l, node, &PROBE)?;
+            let probe_node = self.probe_node(&e, i, model)?;
+            nodes.push((probe_node, l));
             let (column, _) = self
                 .string(&e, "column")?
                 .ok_or_else(|| self.missing(&e, "column", "the probe's column in the data file"))?;
@@ -435,17 +449,25 @@ impl Parser<'_> {
                 sensitivity,
             });
         }
-        let sep = probes::separation_deg(probes_v[0].angle, probes_v[1].angle);
-        if sep < probes::MIN_PROBE_SEPARATION_DEG - 1e-9 {
-            return Err(ScenarioFileError::Inconsistent {
-                origin: self.origin.to_owned(),
-                line: angle_lines[1],
-                message: format!(
-                    "acquisition.probe.angle_deg: probes at {} deg and {} deg are {sep:.1} deg apart (as lines of sight): they must be at least 30 deg apart",
-                    probes_v[0].angle.to_degrees(),
-                    probes_v[1].angle.to_degrees()
-                ),
-            });
+        // The pairs: the two probes of a lumped rotor, or each node's two (file indices).
+        let pairs: Vec<Pair> = match model {
+            Some(_) => vec![(None, [0, 1])],
+            None => self.node_pairs(&nodes, &probes_v)?,
+        };
+        for (node, [a, b]) in &pairs {
+            let sep = probes::separation_deg(probes_v[*a].angle, probes_v[*b].angle);
+            if sep < probes::MIN_PROBE_SEPARATION_DEG - 1e-9 {
+                let at = node.map_or(String::new(), |(n, _)| format!(" (node {n})"));
+                return Err(ScenarioFileError::Inconsistent {
+                    origin: self.origin.to_owned(),
+                    line: angle_lines[*b],
+                    message: format!(
+                        "acquisition.probe.angle_deg: probes at {} deg and {} deg{at} are {sep:.1} deg apart (as lines of sight): they must be at least 30 deg apart",
+                        probes_v[*a].angle.to_degrees(),
+                        probes_v[*b].angle.to_degrees()
+                    ),
+                });
+            }
         }
         // Keyphasor.
         let Some((kl, kv)) = top.get("keyphasor") else {
@@ -527,7 +549,7 @@ impl Parser<'_> {
             }
         };
         let simulate = match top.get("simulate") {
-            None => RawSettings::default(),
+            None => default_simulate(probes_v.len()),
             Some((l, v)) => {
                 let e = self.entries(
                     "acquisition.simulate",
@@ -535,26 +557,152 @@ impl Parser<'_> {
                     self.table_of("acquisition.simulate", l, v)?,
                     &SIMULATE[..15],
                 )?;
-                self.simulate(&e)?
+                self.simulate(&e, probes_v.len())?
             }
         };
-        let [p1, p2]: [Probe; 2] = probes_v.try_into().expect("two probes");
-        Ok(Acquisition {
-            time,
-            probes: [p1, p2],
-            keyphasor: Keyphasor {
-                column: kcol,
-                edge,
-                threshold,
-                angle: kangle,
-            },
-            slow_roll,
-            runout_harmonics: harmonics,
-            simulate,
+        let (settings, gaps, runouts) = simulate;
+        let pair_of = |[a, b]: [usize; 2]| {
+            let mut s = settings.clone();
+            s.gap_v = [gaps[a], gaps[b]];
+            s.runout = [runouts[a].clone(), runouts[b].clone()];
+            Acquisition {
+                time: time.clone(),
+                probes: [probes_v[a].clone(), probes_v[b].clone()],
+                keyphasor: Keyphasor {
+                    column: kcol.clone(),
+                    edge,
+                    threshold,
+                    angle: kangle,
+                },
+                slow_roll: slow_roll.clone(),
+                runout_harmonics: harmonics,
+                simulate: s,
+            }
+        };
+        Ok(match model {
+            Some(_) => Acquisitions::Lumped(Box::new(pair_of([0, 1]))),
+            None => Acquisitions::FiniteElement(FeAcquisitionSpec {
+                acquisition: FeAcquisition {
+                    nodes: pairs
+                        .iter()
+                        .map(|(n, p)| FeNodeProbes {
+                            node: n.expect("a node per pair").0,
+                            acquisition: pair_of(*p),
+                        })
+                        .collect(),
+                },
+                node_lines: pairs
+                    .iter()
+                    .map(|(n, p)| (p[0], n.expect("a node per pair").1))
+                    .collect(),
+                origin: self.origin.to_owned(),
+            }),
         })
     }
 
-    fn simulate(&self, e: &Entries<'_>) -> Result<RawSettings, ScenarioFileError> {
+    /// The `node` of probe `i` (`acquisition.probe[i]`): required for a finite-element rotor
+    /// (`model` `None`), refused for a lumped one; with its line.
+    fn probe_node(
+        &self,
+        e: &Entries<'_>,
+        i: usize,
+        model: Option<crate::parameter::ModelKind>,
+    ) -> Result<Option<(u32, Option<usize>)>, ScenarioFileError> {
+        let given = e.get("node");
+        match (model, given) {
+            (Some(m), Some((l, _))) => Err(ScenarioFileError::Inconsistent {
+                origin: self.origin.to_owned(),
+                line: l,
+                message: format!(
+                    "acquisition.probe[{i}].node: a probe's node is for a finite-element rotor \
+                     (rotor.model = \"finite_element\", two probes per measured node); this \
+                     scenario's rotor is {}: its two probes measure the disk and take no node",
+                    m.name()
+                ),
+            }),
+            (Some(_), None) => Ok(None),
+            (None, None) => Err(self.missing(
+                e,
+                "node",
+                "the node the probe measures (an integer node of the matrices' dofs with x and \
+                 y): every probe of a finite-element rotor names one, two probes per node",
+            )),
+            (None, Some((l, v))) => {
+                match v.value() {
+                    Some(Value::Integer(n)) => u32::try_from(*n.value())
+                        .map(|n| Some((n, l)))
+                        .map_err(|_| {
+                            self.range(
+                                l,
+                                &format!("acquisition.probe[{i}].node"),
+                                *n.value() as f64,
+                                "a node number 0, 1, ... (below 2^32)",
+                            )
+                        }),
+                    _ => Err(self.err_type(
+                        l,
+                        &format!("acquisition.probe[{i}].node"),
+                        v,
+                        "an integer node number (0, 1, ...)",
+                    )),
+                }
+            }
+        }
+    }
+
+    /// The probes of a finite-element rotor grouped by node, in the order the nodes first
+    /// appear: (node and the line of its first probe's `node`, the two probes' indices).
+    /// A node with one probe, or more than two, is an error naming it.
+    fn node_pairs(
+        &self,
+        nodes: &[(Option<NodeLine>, Option<usize>)],
+        probes_v: &[Probe],
+    ) -> Result<Vec<Pair>, ScenarioFileError> {
+        let mut groups: Vec<(u32, Option<usize>, Vec<usize>)> = Vec::new();
+        for (i, (n, _)) in nodes.iter().enumerate() {
+            let (node, line) = n.expect("every probe of a finite-element rotor has a node");
+            match groups.iter_mut().find(|g| g.0 == node) {
+                Some(g) => g.2.push(i),
+                None => groups.push((node, line, vec![i])),
+            }
+        }
+        if groups.is_empty() {
+            return Err(ScenarioFileError::Inconsistent {
+                origin: self.origin.to_owned(),
+                line: None,
+                message: "acquisition.probe has no tables: a finite-element rotor needs two \
+                          [[acquisition.probe]] per measured node, each with node = N"
+                    .into(),
+            });
+        }
+        let mut pairs = Vec::with_capacity(groups.len());
+        for (node, line, idx) in groups {
+            let columns: Vec<String> = idx
+                .iter()
+                .map(|&i| format!("{:?}", probes_v[i].column))
+                .collect();
+            if idx.len() != 2 {
+                let last = idx[idx.len() - 1];
+                return Err(ScenarioFileError::Inconsistent {
+                    origin: self.origin.to_owned(),
+                    line: nodes[last].0.and_then(|(_, l)| l).or(line),
+                    message: format!(
+                        "acquisition.probe[{last}].node = {node}: node {node} has {} probe(s) \
+                         (column {}): each measured node needs exactly two, their lines of \
+                         sight at least 30 deg apart, which give its x and y",
+                        idx.len(),
+                        columns.join(", ")
+                    ),
+                });
+            }
+            pairs.push((Some((node, line)), [idx[0], idx[1]]));
+        }
+        Ok(pairs)
+    }
+
+    /// `[acquisition.simulate]` for `n` probes: the settings, and each probe's gap \[V\]
+    /// and runout (by default the defaults of probe 1 and 2 in turn).
+    fn simulate(&self, e: &Entries<'_>, n: usize) -> Result<SimulateSettings, ScenarioFileError> {
         let mut s = RawSettings::default();
         let fin = |v: f64| v.is_finite();
         let pair = |k: &str, allowed: &str| -> Result<Option<[f64; 2]>, ScenarioFileError> {
@@ -576,8 +724,26 @@ impl Parser<'_> {
                 }
             }
         };
-        if let Some(g) = pair("gap_v", "finite (V), probe 1 then probe 2")? {
-            s.gap_v = g;
+        let (mut gaps, mut runouts) = per_probe_defaults(n);
+        if n == 2 {
+            if let Some(g) = pair("gap_v", "finite (V), probe 1 then probe 2")? {
+                gaps = g.to_vec();
+            }
+        } else if let Some((rows, line)) =
+            self.numbers(e, "gap_v", "finite (V), one per probe", fin)?
+        {
+            let flat: Vec<f64> = rows.into_iter().flatten().collect();
+            if flat.len() != n {
+                return Err(ScenarioFileError::Inconsistent {
+                    origin: self.origin.to_owned(),
+                    line,
+                    message: format!(
+                        "acquisition.simulate.gap_v has {} values: give {n}, one per probe in the order of [[acquisition.probe]] (finite, V)",
+                        flat.len()
+                    ),
+                });
+            }
+            gaps = flat;
         }
         if let Some(r) = pair("range_v", "finite (V), low then high")? {
             if r[1] <= r[0] {
@@ -600,35 +766,38 @@ impl Parser<'_> {
             let a = amps.map(|(r, _)| r);
             let p = phases.map(|(r, _)| r);
             let rows = a.as_ref().or(p.as_ref()).map_or(0, Vec::len);
-            let shape_ok = rows == 2
+            let shape_ok = rows == n
                 && match (&a, &p) {
-                    (Some(a), Some(p)) => {
-                        a.len() == 2 && a[0].len() == p[0].len() && a[1].len() == p[1].len()
-                    }
+                    (Some(a), Some(p)) => a.len() == n && (0..n).all(|k| a[k].len() == p[k].len()),
                     _ => true,
                 };
             if !shape_ok {
+                let message = if n == 2 {
+                    "acquisition.simulate.runout_um and runout_phase_deg must each hold two arrays (probe 1, probe 2) of the same lengths, harmonics 1X, 2X, ...".to_owned()
+                } else {
+                    format!("acquisition.simulate.runout_um and runout_phase_deg must each hold {n} arrays (one per probe, in the order of [[acquisition.probe]]) of the same lengths, harmonics 1X, 2X, ...")
+                };
                 return Err(ScenarioFileError::Inconsistent {
                     origin: self.origin.to_owned(),
                     line,
-                    message: "acquisition.simulate.runout_um and runout_phase_deg must each hold two arrays (probe 1, probe 2) of the same lengths, harmonics 1X, 2X, ...".into(),
+                    message,
                 });
             }
-            for k in 0..2 {
-                let n = a
+            for (k, runout) in runouts.iter_mut().enumerate() {
+                let len = a
                     .as_ref()
                     .map_or_else(|| p.as_ref().expect("one given")[k].len(), |a| a[k].len());
-                s.runout[k] = (0..n)
+                *runout = (0..len)
                     .map(|h| RunoutHarmonic {
                         harmonic: h as u32 + 1,
                         amplitude: a
                             .as_ref()
-                            .map_or(s.runout[k].get(h).map_or(0.0, |r| r.amplitude), |a| {
+                            .map_or(runout.get(h).map_or(0.0, |r| r.amplitude), |a| {
                                 a[k][h] * 1e-6
                             }),
                         phase: p
                             .as_ref()
-                            .map_or(s.runout[k].get(h).map_or(0.0, |r| r.phase), |p| {
+                            .map_or(runout.get(h).map_or(0.0, |r| r.phase), |p| {
                                 p[k][h].to_radians()
                             }),
                     })
@@ -732,7 +901,91 @@ impl Parser<'_> {
                 "less than kp_width_deg (deg)",
             ));
         }
-        Ok(s)
+        s.gap_v = [gaps[0], gaps[1]];
+        s.runout = [runouts[0].clone(), runouts[1].clone()];
+        Ok((s, gaps, runouts))
+    }
+}
+
+/// The default gap and runout of each of `n` probes: those of probe 1 and probe 2 of
+/// [`RawSettings::default`] in turn.
+fn per_probe_defaults(n: usize) -> (Vec<f64>, Vec<Vec<RunoutHarmonic>>) {
+    let d = RawSettings::default();
+    (
+        (0..n).map(|k| d.gap_v[k % 2]).collect(),
+        (0..n).map(|k| d.runout[k % 2].clone()).collect(),
+    )
+}
+
+/// [`RawSettings::default`] for `n` probes ([`per_probe_defaults`]).
+fn default_simulate(n: usize) -> SimulateSettings {
+    let (gaps, runouts) = per_probe_defaults(n);
+    (RawSettings::default(), gaps, runouts)
+}
+
+/// What `[acquisition]` gives: the two probes of a lumped rotor, or the probe pairs of a
+/// finite-element rotor.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Acquisitions {
+    /// `jeffcott`, `cross_coupled`.
+    Lumped(Box<Acquisition>),
+    /// `finite_element`.
+    FiniteElement(FeAcquisitionSpec),
+}
+
+/// The `[acquisition]` of a finite-element scenario, parsed and checked key by key; whether
+/// each node has its x and y is known only with the matrices ([`Self::checked`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeAcquisitionSpec {
+    acquisition: FeAcquisition,
+    /// Per node: the index of its first probe and the line of its `node`.
+    node_lines: Vec<(usize, Option<usize>)>,
+    origin: String,
+}
+
+impl FeAcquisitionSpec {
+    /// The acquisition, once every probe's node is found to have `x` and `y` in the
+    /// matrices `matrices` read from `matrices_file` (named in messages).
+    pub fn checked(
+        &self,
+        matrices: &FeMatrices,
+        matrices_file: &str,
+    ) -> Result<&FeAcquisition, ScenarioFileError> {
+        for (n, (i, line)) in self.acquisition.nodes.iter().zip(&self.node_lines) {
+            for kind in [DofKind::X, DofKind::Y] {
+                let d = Dof::new(n.node, kind);
+                if matrices.index(d).is_none() {
+                    let mut nodes: Vec<u32> = matrices
+                        .dofs()
+                        .iter()
+                        .filter(|d| {
+                            d.kind == DofKind::X
+                                && matrices.index(Dof::new(d.node, DofKind::Y)).is_some()
+                        })
+                        .map(|d| d.node)
+                        .collect();
+                    nodes.dedup();
+                    let nodes: Vec<String> = nodes.iter().map(u32::to_string).collect();
+                    return Err(ScenarioFileError::Inconsistent {
+                        origin: self.origin.clone(),
+                        line: *line,
+                        message: format!(
+                            "acquisition.probe[{i}].node = {}: the matrices file \
+                             {matrices_file} has no degree of freedom {d} in dofs (a probe \
+                             measures its node's x and y); allowed nodes: {}",
+                            n.node,
+                            nodes.join(", ")
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(&self.acquisition)
+    }
+
+    /// The acquisition, its nodes not yet checked against the matrices.
+    pub fn unchecked(&self) -> &FeAcquisition {
+        &self.acquisition
     }
 }
 
@@ -864,5 +1117,74 @@ slow_roll = "slowroll.csv"
         let one = CONTRACT.replacen("[[acquisition.probe]]\ncolumn = \"probe_R\"\nangle_deg = 45.0\nsensitivity_mv_per_mil = 200.0\n", "", 1);
         let e = parse(&one).unwrap_err().to_string();
         assert!(e.contains("exactly two"), "{e}");
+    }
+
+    /// A finite-element rotor's probes: grouped by node in the order the nodes first
+    /// appear, each node's pair with its own gaps and runouts (one per probe in file
+    /// order), the rest shared.
+    #[test]
+    fn probes_at_nodes_are_paired_with_their_own_gaps_and_runouts() {
+        let text = "[rotor]\nmodel = \"finite_element\"\nmatrices = \"m.npz\"\n\
+            [acquisition]\nrate_hz = 10000.0\n\
+            [[acquisition.probe]]\ncolumn = \"a\"\nnode = 6\nangle_deg = 0.0\nsensitivity = 1.0\n\
+            [[acquisition.probe]]\ncolumn = \"b\"\nnode = 0\nangle_deg = 45.0\nsensitivity = 2.0\n\
+            [[acquisition.probe]]\ncolumn = \"c\"\nnode = 0\nangle_deg = 135.0\nsensitivity = 3.0\n\
+            [[acquisition.probe]]\ncolumn = \"d\"\nnode = 6\nangle_deg = 90.0\nsensitivity = 4.0\n\
+            [acquisition.keyphasor]\ncolumn = \"kp\"\n\
+            [acquisition.simulate]\ngap_v = [-1.0, -2.0, -3.0, -4.0]\nseed = 9\n\
+            runout_um = [[1.0], [2.0], [3.0], [4.0, 0.5]]\n\
+            runout_phase_deg = [[0.0], [0.0], [0.0], [0.0, 90.0]]\n";
+        let spec = ScenarioSpec::parse("fe.toml", text).unwrap();
+        assert!(spec.acquisition().is_none());
+        let fe = spec.fe_acquisition().unwrap().unchecked();
+        let nodes: Vec<u32> = fe.nodes.iter().map(|n| n.node).collect();
+        assert_eq!(nodes, [6, 0]);
+        let cols = |k: usize| {
+            fe.nodes[k]
+                .acquisition
+                .probes
+                .iter()
+                .map(|p| {
+                    (
+                        p.column.as_str(),
+                        p.sensitivity,
+                        p.angle.to_degrees().round(),
+                    )
+                })
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(cols(0), [("a", 1.0, 0.0), ("d", 4.0, 90.0)]);
+        assert_eq!(cols(1), [("b", 2.0, 45.0), ("c", 3.0, 135.0)]);
+        let sim = |k: usize| &fe.nodes[k].acquisition.simulate;
+        assert_eq!(sim(0).gap_v, [-1.0, -4.0]);
+        assert_eq!(sim(1).gap_v, [-2.0, -3.0]);
+        assert_eq!(sim(0).runout[1].len(), 2);
+        assert_eq!(sim(0).runout[1][1].amplitude, 0.5e-6);
+        assert_eq!(sim(0).runout[0][0].amplitude, 1e-6);
+        assert_eq!(sim(1).runout[0][0].amplitude, 2e-6);
+        assert_eq!(sim(1).runout[1][0].amplitude, 3e-6);
+        assert_eq!((sim(0).seed, sim(1).seed), (9, 9));
+        assert_eq!(
+            fe.dofs().iter().map(|d| d.to_string()).collect::<Vec<_>>(),
+            ["6.x", "6.y", "0.x", "0.y"]
+        );
+        // three gaps for four probes, a node of three probes
+        let e = ScenarioSpec::parse("fe.toml", &text.replace("-3.0, -4.0]", "-3.0]"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("gap_v has 3 values: give 4, one per probe"),
+            "{e}"
+        );
+        let e = ScenarioSpec::parse(
+            "fe.toml",
+            &text.replace("node = 0\nangle_deg = 135.0", "node = 6\nangle_deg = 135.0"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("node 6 has 3 probe(s) (column \"a\", \"c\", \"d\")"),
+            "{e}"
+        );
     }
 }

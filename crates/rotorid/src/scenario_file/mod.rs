@@ -81,6 +81,7 @@ mod parse;
 use std::collections::BTreeMap;
 use std::fmt;
 
+pub use acquisition::FeAcquisitionSpec;
 pub use error::{RotorModel, ScenarioFileError};
 pub use finite_element::{FiniteElementSpec, FINITE_ELEMENT};
 
@@ -229,6 +230,8 @@ pub struct ScenarioSpec {
     sampling: Option<Section>,
     initial: Section,
     acquisition: Option<crate::acquisition::Acquisition>,
+    /// The `[acquisition]` of a finite-element rotor (probes at nodes).
+    fe_acquisition: Option<FeAcquisitionSpec>,
     /// The rotor when `rotor.model = "finite_element"` (then `rotor` holds no key).
     finite_element: Option<FiniteElementSpec>,
 }
@@ -303,6 +306,7 @@ impl ScenarioSpec {
             sampling: None,
             initial: Section::default(),
             acquisition: None,
+            fe_acquisition: None,
             finite_element: None,
         }
     }
@@ -312,6 +316,14 @@ impl ScenarioSpec {
     /// written, relative to the scenario file.
     pub fn acquisition(&self) -> Option<&crate::acquisition::Acquisition> {
         self.acquisition.as_ref()
+    }
+
+    /// The `[acquisition]` table of a finite-element scenario (two probes per measured
+    /// node, `[[acquisition.probe]] node = N`), when the file has one; its nodes are
+    /// checked against the matrices by [`FeAcquisitionSpec::checked`]. A finite-element
+    /// scenario has no [`Self::acquisition`].
+    pub fn fe_acquisition(&self) -> Option<&FeAcquisitionSpec> {
+        self.fe_acquisition.as_ref()
     }
 
     /// The finite-element rotor's `[rotor]` (its matrices file as written, relative to the
@@ -411,6 +423,11 @@ impl ScenarioSpec {
             .validated()
             .map_err(|e| ScenarioFileError::from_model(o, None, e, INITIAL_FLAGS))?;
         Ok(sc)
+    }
+
+    /// The `[speed]` profile, when the file has one (any model).
+    pub fn speed_profile(&self) -> Option<&SpeedProfile> {
+        self.speed.as_ref()
     }
 
     /// The speed profile and sampling grid of a finite-element scenario's simulation

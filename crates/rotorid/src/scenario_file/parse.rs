@@ -13,6 +13,7 @@ use std::ops::Range;
 
 use toml_edit::{ImDocument, Item, Key, Value};
 
+use super::acquisition::Acquisitions;
 use super::error::RotorModel;
 use super::finite_element::{FINITE_ELEMENT, FINITE_ELEMENT_KEYS};
 use super::{
@@ -108,7 +109,7 @@ impl Parser<'_> {
                 rotor_item = Some((item, line));
             }
             if name == "acquisition" {
-                acquisition = Some(self.acquisition(item, line)?);
+                acquisition = Some((item, line));
                 continue;
             }
             let Some(sec) = SECTIONS.iter().find(|s| **s == name) else {
@@ -159,6 +160,14 @@ impl Parser<'_> {
             }
             _ => None,
         };
+        // [acquisition] once the model is known: a finite-element rotor's probes name nodes
+        let (acquisition, fe_acquisition) = match acquisition {
+            None => (None, None),
+            Some((item, line)) => match self.acquisition(item, line, model)? {
+                Acquisitions::Lumped(a) => (Some(*a), None),
+                Acquisitions::FiniteElement(a) => (None, Some(a)),
+            },
+        };
         let model = model.unwrap_or(ModelKind::Jeffcott);
         let fe_rotor = finite_element
             .is_some()
@@ -208,6 +217,7 @@ impl Parser<'_> {
             sampling,
             initial: initial.unwrap_or_default(),
             acquisition,
+            fe_acquisition,
             finite_element,
         })
     }
