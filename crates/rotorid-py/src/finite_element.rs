@@ -60,8 +60,10 @@ pub fn identify(
     modes: Option<usize>,
 ) -> Result<String, Error> {
     use rotorid::model::finite_element::{Dof, FeParameter};
+    use rotorid::refine::finite_element::{
+        refine_fe, FeData, FeInitial, FeRefineOptions, FeSummary,
+    };
     use rotorid::scenario_file::SimulationOverrides;
-    use rotorid::refine::finite_element::{refine_fe, FeData, FeInitial, FeRefineOptions, FeSummary};
     use rotorid::simulate::finite_element::FeResponse;
 
     let (start, _) = load(toml_path)?;
@@ -122,9 +124,7 @@ pub fn identify(
         response: &data,
         speed,
     };
-    let dt = fe
-        .checked_dt()
-        .map_err(|e| Error::invalid(e.to_string()))?;
+    let dt = fe.checked_dt().map_err(|e| Error::invalid(e.to_string()))?;
     let fit = refine_fe(&fe, &start, &options).map_err(|e| Error::invalid(e.to_string()))?;
     let mut summary = FeSummary::new(&fit, (data.t[0], data.t[n - 1]), dt, &|_| None);
     summary.scenario = Some(toml_path.to_owned());

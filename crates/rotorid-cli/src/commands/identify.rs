@@ -4,6 +4,7 @@
 //! summary (the serialised `Identification`) and a report on stderr.
 
 mod args;
+mod finite_element;
 mod report;
 mod stream;
 
@@ -17,6 +18,23 @@ use crate::io::{check_distinct_files, is_broken_pipe, open_input, FileMode, Outp
 
 /// Run `rotorid identify`: scenario and options -> pipeline -> outputs.
 pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
+    let spec = ScenarioSpec::load(&args.scenario)?;
+    if spec.finite_element().is_some() {
+        return finite_element::run(&args, &spec);
+    }
+    for (flag, given) in [
+        ("--initial", args.initial.is_some()),
+        ("--modes", args.modes.is_some()),
+    ] {
+        if given {
+            anyhow::bail!(
+                "{flag} applies to a finite-element rotor only (rotor.model = \"finite_element\"), \
+                 not to the {} model of {}",
+                spec.model().name(),
+                spec.origin()
+            );
+        }
+    }
     let method = method_of(args.method, &args.settings, args.every)?;
     if !(args.time_tolerance.is_finite() && args.time_tolerance >= 0.0) {
         anyhow::bail!(
@@ -32,7 +50,6 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         &[("the input", &args.input), ("--scenario", &args.scenario)],
         &outputs,
     )?;
-    let spec = ScenarioSpec::load(&args.scenario)?;
     let columns = args.columns.as_deref();
     let (name, input) = if let Some(acq) = spec.acquisition() {
         // a raw acquisition: conditioned and identified until the rotor guess settles,

@@ -22,8 +22,8 @@
 pub use rotorid_io::csv::{columns, error as csv_error, lines, number};
 
 pub mod estimates_csv;
-pub mod fe_summary;
 pub mod fe_response;
+pub mod fe_summary;
 pub mod finite_element;
 pub mod identified;
 pub mod message;

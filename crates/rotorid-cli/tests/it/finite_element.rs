@@ -165,3 +165,190 @@ fn noise_is_reproducible_and_two_dof_options_are_refused() {
         "{e}"
     );
 }
+
+/// The value of `name` in a summary's parameters.
+fn param<'a>(s: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    s["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["parameter"] == name)
+        .unwrap_or_else(|| panic!("{name} in {s}"))
+}
+
+#[test]
+fn identify_of_a_one_node_rotor_equals_the_cross_coupled_refine_on_the_same_data() {
+    // the same noisy record identified twice: as a finite-element rotor (refine_fe: the
+    // reduced model, unit responses and finite differences) and as the cross-coupled 2-DOF
+    // model (rotorid's 2-DOF refine, another code) under x = x, y = -z: the same maximum-
+    // likelihood problem, so the same estimates and standard errors
+    let dir = tempfile::tempdir().unwrap();
+    let (fe, cross) = scenarios(dir.path(), false);
+    let rec = simulate(&["--scenario", &cross, "--snr-db", "40", "--seed", "3"]);
+    let (header, rows) = columns(&rec);
+    assert!(header.starts_with("t,x,z,"), "{header}");
+    let mut fe_csv = String::from("t,0.x,0.y\n");
+    for r in &rows {
+        fe_csv.push_str(&format!("{:e},{:e},{:e}\n", r[0], r[1], -r[2]));
+    }
+    let (fe_rec, cross_rec) = (dir.path().join("fe.csv"), dir.path().join("cross.csv"));
+    std::fs::write(&fe_rec, fe_csv).unwrap();
+    std::fs::write(&cross_rec, &rec).unwrap();
+    let (est, s) =
+        crate::common::identify_outputs(dir.path(), fe_rec.to_str().unwrap(), &fe, "refine", &[]);
+    let (_, c) = crate::common::identify_outputs(
+        dir.path(),
+        cross_rec.to_str().unwrap(),
+        &cross,
+        "refine",
+        &["--unknowns", "cxx,czz,kxx,kzz,unbalance"],
+    );
+    assert_eq!(s["model"], "finite_element");
+    assert_eq!(s["schema"], 3);
+    assert_eq!(s["initial"], "estimated");
+    assert_eq!(s["record"]["channels"], serde_json::json!(["0.x", "0.y"]));
+    assert_eq!(s["converged"], true);
+    assert_eq!(s["adequacy"]["model_adequate"], true);
+    let names: Vec<&str> = s["covariance"]["names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "bearing0.kxx",
+            "bearing0.kyy",
+            "bearing0.cxx",
+            "bearing0.cyy",
+            "unbalance0.mud",
+            "unbalance0.alpha"
+        ]
+    );
+    let two_dof = |n: &str| -> serde_json::Value {
+        c["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["parameter"] == n)
+            .unwrap_or_else(|| panic!("{n} in {c}"))
+            .clone()
+    };
+    for (f, x, shift) in [
+        ("bearing0.kxx", "kxx", 0.0),
+        ("bearing0.kyy", "kzz", 0.0),
+        ("bearing0.cxx", "cxx", 0.0),
+        ("bearing0.cyy", "czz", 0.0),
+        ("unbalance0.mud", "mud", 0.0),
+        ("unbalance0.alpha", "alpha", -std::f64::consts::FRAC_PI_2),
+    ] {
+        let (a, b) = (param(&s, f), &two_dof(x));
+        let (va, vb) = (
+            a["value"].as_f64().unwrap(),
+            b["estimate"].as_f64().unwrap() + shift,
+        );
+        let (sa, sb) = (
+            a["std_error"].as_f64().unwrap(),
+            b["std_error"].as_f64().unwrap(),
+        );
+        println!("{f}: {va:.9e} +- {sa:.3e}   2-DOF {x}: {vb:.9e} +- {sb:.3e}");
+        assert!((va - vb).abs() < 0.01 * sa, "{f}: {va} vs {vb} (std {sa})");
+        assert!((sa / sb - 1.0).abs() < 0.01, "{f}: std {sa} vs {sb}");
+    }
+    // the estimates table: one row, each unknown and its standard error, units in the header
+    let est = String::from_utf8(est).unwrap();
+    let mut lines = est.lines();
+    let h = lines.next().unwrap();
+    assert!(
+        h.starts_with("t,bearing0.kxx [N/m],bearing0.kxx_std [N/m],"),
+        "{h}"
+    );
+    assert_eq!(lines.count(), 1);
+}
+
+#[test]
+fn identify_of_a_finite_element_rotor_refuses_what_does_not_apply_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let (fe, cross) = scenarios(dir.path(), false);
+    let rec = dir.path().join("r.csv");
+    std::fs::write(&rec, "t,0.x,0.y\n0,0,0\n0.0001,0,0\n").unwrap();
+    let run = |args: &[&str]| {
+        let out = rotorid().arg("identify").args(args).output().unwrap();
+        assert!(!out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let r = rec.to_str().unwrap();
+    let e = run(&[r, "--scenario", &fe, "--method", "algebraic", "--out", "-"]);
+    assert!(e.contains("--method refine"), "{e}");
+    let e = run(&[
+        r,
+        "--scenario",
+        &fe,
+        "--method",
+        "refine",
+        "--unknowns",
+        "bearing3.kxx",
+        "--out",
+        "-",
+    ]);
+    assert!(
+        e.contains("bearing3.kxx") && e.contains("bearing0 .. bearing0"),
+        "{e}"
+    );
+    let e = run(&[
+        r,
+        "--scenario",
+        &fe,
+        "--method",
+        "refine",
+        "--initial",
+        "moving",
+        "--out",
+        "-",
+    ]);
+    assert!(e.contains("moving") && e.contains("rest"), "{e}");
+    let e = run(&[
+        r,
+        "--scenario",
+        &fe,
+        "--method",
+        "refine",
+        "--modes",
+        "3",
+        "--out",
+        "-",
+    ]);
+    assert!(e.contains("--modes = 3") && e.contains("1 ..= 2"), "{e}");
+    // and the finite-element flags on a 2-DOF scenario
+    let e = run(&[
+        r,
+        "--scenario",
+        &cross,
+        "--method",
+        "refine",
+        "--initial",
+        "rest",
+        "--out",
+        "-",
+    ]);
+    assert!(
+        e.contains("--initial applies to a finite-element rotor only"),
+        "{e}"
+    );
+    let e = run(&[
+        r,
+        "--scenario",
+        &cross,
+        "--method",
+        "refine",
+        "--unknowns",
+        "bearing0.kxx",
+        "--out",
+        "-",
+    ]);
+    assert!(
+        e.contains("invalid value 'bearing0.kxx'") && e.contains("finite_element"),
+        "{e}"
+    );
+}

@@ -188,6 +188,17 @@ pub struct IdentifyArgs {
     /// Do not print the summary on stderr (warnings are still printed).
     #[arg(long, short)]
     pub quiet: bool,
+
+    /// Finite-element rotors only: `rest` when the record starts at rest (the initial
+    /// state is known: zero), `estimated` to fit it with the parameters [default:
+    /// estimated].
+    #[arg(long, value_name = "rest|estimated")]
+    pub initial: Option<String>,
+
+    /// Finite-element rotors only: modes in the Ritz basis of the reduced model (with the
+    /// static shapes at the bearing and unbalance nodes) [default: 8].
+    #[arg(long, value_name = "N")]
+    pub modes: Option<usize>,
 }
 
 /// The method's settings, shared by `rotorid identify` and `rotorid worker` (each checked
@@ -206,9 +217,12 @@ pub struct MethodOptions {
     /// kx, cz, kz (Jeffcott) or m, cxx, cxz, czx, czz, kxx, kxz, kzx, kzz (cross-coupled),
     /// and a, unbalance (m_u d and alpha) [default: m and the model's bearing
     /// coefficients]. The initial state is always estimated; the others are known (from
-    /// the scenario).
-    #[arg(long, value_enum, value_name = "NAMES", value_delimiter = ',')]
-    pub unknowns: Option<Vec<UnknownName>>,
+    /// the scenario). A finite-element rotor: bearing<i>.kxx .. bearing<i>.cyy,
+    /// unbalance<j>.mud, unbalance<j>.alpha, or the groups bearings (direct
+    /// coefficients), bearing<i> (its eight), unbalances, unbalance<j> [default: bearings,
+    /// unbalances].
+    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
+    pub unknowns: Option<Vec<String>>,
 
     #[arg(long, value_name = "RULE", help = concat!(
         "Running quadrature of the algebraic identifier's iterated integrals: trapezoid ",
@@ -429,7 +443,7 @@ pub fn method_of(
         Modulating => Method::Modulating(modulating),
         Refine => Method::Refine(RefineSettings {
             model,
-            unknowns: unknowns_of(args.unknowns.as_deref()),
+            unknowns: unknowns_of(args.unknowns.as_deref())?,
             algebraic,
             modulating,
             ..RefineSettings::default()
@@ -438,11 +452,29 @@ pub fn method_of(
 }
 
 /// The unknowns `--unknowns` selects (`None`: the model's default); the initial state is
-/// always estimated.
-fn unknowns_of(names: Option<&[UnknownName]>) -> Option<Unknowns> {
-    let names = names?;
-    let ps: Vec<Parameter> = names.iter().flat_map(|n| n.parameters()).copied().collect();
-    Some(Unknowns::from_parameters(&ps, true))
+/// always estimated. A name that is not one of [`UnknownName`] is refused with the list.
+fn unknowns_of(names: Option<&[String]>) -> anyhow::Result<Option<Unknowns>> {
+    use clap::ValueEnum as _;
+    let Some(names) = names else {
+        return Ok(None);
+    };
+    let mut ps: Vec<Parameter> = Vec::new();
+    for n in names {
+        let Ok(u) = UnknownName::from_str(n, false) else {
+            let allowed: Vec<String> = UnknownName::value_variants()
+                .iter()
+                .filter_map(|v| v.to_possible_value().map(|p| p.get_name().to_owned()))
+                .collect();
+            anyhow::bail!(
+                "invalid value '{n}' for '--unknowns <NAMES>' [possible values: {}] (the \
+                 names of a finite-element rotor, bearing<i>.kxx ..., apply to a scenario \
+                 with rotor.model = \"finite_element\")",
+                allowed.join(", ")
+            );
+        };
+        ps.extend(u.parameters().iter().copied());
+    }
+    Ok(Some(Unknowns::from_parameters(&ps, true)))
 }
 
 #[cfg(test)]

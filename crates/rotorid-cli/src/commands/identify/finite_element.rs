@@ -1,0 +1,196 @@
+//! `rotorid identify DATA --scenario fe.toml --method refine`: a finite-element rotor's
+//! bearings and unbalances by maximum likelihood on the reduced model
+//! (`rotorid::refine::finite_element`, docs/finite_element.md section 6). The scenario's
+//! values of the unknowns are where the fit starts; the others are known.
+
+use anyhow::{bail, Context as _};
+
+use rotorid::model::finite_element::FeParameter;
+use rotorid::refine::finite_element::{refine_fe, FeData, FeInitial, FeRefineOptions, FeSummary};
+use rotorid::simulate::finite_element::FeResponse;
+
+use super::{IdentifyArgs, IdentifyMethod};
+use crate::io::{check_distinct_files, FileMode, Output, ScenarioSpec};
+
+/// Identify a finite-element rotor (module doc).
+pub fn run(args: &IdentifyArgs, spec: &ScenarioSpec) -> anyhow::Result<()> {
+    if args.method != IdentifyMethod::Refine {
+        bail!(
+            "{}: a finite-element rotor is identified by --method refine (maximum likelihood \
+             on the reduced model), not --method {:?}",
+            spec.origin(),
+            args.method
+        );
+    }
+    for (flag, given) in [
+        ("--columns", args.columns.is_some()),
+        ("--every", args.every.is_some()),
+        ("--model", args.settings.model.is_some()),
+    ] {
+        if given {
+            bail!("{flag} does not apply to a finite-element rotor (rotor.model = \"finite_element\")");
+        }
+    }
+    let mut outputs = vec![("--out", args.out.as_str())];
+    if let Some(s) = &args.summary {
+        outputs.push(("--summary", s.as_str()));
+    }
+    check_distinct_files(
+        &[("the input", &args.input), ("--scenario", &args.scenario)],
+        &outputs,
+    )?;
+    let start = crate::io::finite_element::finite_element_of(spec)?;
+    let mut options = FeRefineOptions::new(&start);
+    if let Some(names) = &args.settings.unknowns {
+        options.unknowns = FeParameter::parse_list(&names.join(","), &start)
+            .map_err(|e| anyhow::anyhow!("--unknowns: {e}"))?;
+    }
+    if let Some(init) = &args.initial {
+        options.initial = init
+            .parse::<FeInitial>()
+            .map_err(|e| anyhow::anyhow!("--initial: {e}"))?;
+    }
+    if let Some(m) = args.modes {
+        let n = start.matrices.n();
+        if m == 0 || m > n {
+            bail!(
+                "--modes = {m} is out of range: 1 ..= {n} (the degrees of freedom of the matrices)"
+            );
+        }
+        options.modes = m;
+    }
+    if spec.fe_acquisition().is_some() {
+        bail!(
+            "{}: identifying a raw finite-element acquisition is not available yet: condition \
+             it with `rotorid condition {} --scenario {}` and mind that each conditioned \
+             channel keeps a constant offset (the mean of a start-up transient), which the \
+             finite-element fit does not model",
+            spec.origin(),
+            args.input,
+            args.scenario
+        );
+    }
+    let Some(&speed) = spec.speed_profile() else {
+        bail!(
+            "{}: a finite-element identification needs the scenario's [speed] (kind = \
+             \"constant\" with rpm, or kind = \"ramp\" with rpm0 and accel [rad/s^2]): the \
+             model is driven by that profile from the record's first sample",
+            spec.origin()
+        );
+    };
+    let data: FeResponse = crate::io::fe_response::read_fe_response(
+        &args.input,
+        &start,
+        Some(&speed),
+        args.time_tolerance,
+    )?;
+    // a record's own speed columns must be the profile the model is driven by
+    if let Some(i) = (0..data.len()).find(|&i| {
+        let s = speed.at(data.t[i] - data.t[0]);
+        (data.phi_dot[i] - s.omega).abs() > 1e-6 * s.omega.abs().max(1.0)
+    }) {
+        let s = speed.at(data.t[i] - data.t[0]);
+        bail!(
+            "{}: phi_dot at t = {} s is {} rad/s but the scenario's [speed] gives {} rad/s \
+             there: the finite-element fit is driven by the [speed] profile (from the record's \
+             first sample), so the record's speed must follow it (within 1e-6); measured \
+             speed is not used yet",
+            args.input,
+            data.t[i],
+            data.phi_dot[i],
+            s.omega
+        );
+    }
+    let fe = FeData {
+        response: &data,
+        speed,
+    };
+    let dt = fe.checked_dt().with_context(|| args.input.clone())?;
+    let fit = refine_fe(&fe, &start, &options).with_context(|| args.input.clone())?;
+    let t = (data.t[0], data.t[data.t.len() - 1]);
+    let mut summary = FeSummary::new(&fit, t, dt, &|_| None);
+    summary.input = Some(args.input.clone());
+    summary.scenario = Some(spec.origin().to_owned());
+    // the estimates table: one row, t then each unknown and its standard error
+    let mut out = Output::create(&args.out, FileMode::Atomic)?;
+    let mut header = vec!["t".to_owned()];
+    let mut row = vec![ryu_like(t.1)];
+    for p in &summary.parameters {
+        header.push(format!("{} [{}]", p.parameter, p.unit));
+        header.push(format!("{}_std [{}]", p.parameter, p.unit));
+        row.push(p.value.map(ryu_like).unwrap_or_default());
+        row.push(p.std_error.map(ryu_like).unwrap_or_default());
+    }
+    writeln!(out, "{}\n{}", header.join(","), row.join(","))
+        .with_context(|| format!("cannot write {}", args.out))?;
+    out.commit()?;
+    if let Some(path) = &args.summary {
+        let mut f = Output::create(path, FileMode::Atomic)?;
+        serde_json::to_writer_pretty(&mut f, &summary)
+            .with_context(|| format!("cannot write {path}"))?;
+        std::io::Write::write_all(&mut f, b"\n").with_context(|| format!("cannot write {path}"))?;
+        f.commit()?;
+    }
+    if !args.quiet {
+        eprintln!("{}", report(&summary));
+    } else {
+        for d in &summary.diagnostics {
+            eprintln!("warning: {}", serde_json::to_string(d).unwrap_or_default());
+        }
+    }
+    Ok(())
+}
+
+use std::io::Write as _;
+
+fn ryu_like(v: f64) -> String {
+    format!("{v:e}")
+}
+
+/// The human report: each parameter with its standard error, the fit's verdicts.
+fn report(s: &FeSummary) -> String {
+    let mut lines = vec![format!(
+        "finite-element refine of {} ({} samples, channels {}), initial state {:?}, {} modes \
+         + {} static shapes (reduced {} of {} DOF)",
+        s.input.as_deref().unwrap_or("?"),
+        s.record.samples,
+        s.record.channels.join(", "),
+        s.initial,
+        s.reduction.modes,
+        s.reduction.statics,
+        s.reduction.size,
+        s.reduction.full
+    )];
+    for p in &s.parameters {
+        let v = p.estimate.unwrap_or(f64::NAN);
+        let e = p.std_error.unwrap_or(f64::INFINITY);
+        let bias = p
+            .reduction_bias_std
+            .map(|b| format!(", reduction bias {b:+.1e} std"))
+            .unwrap_or_default();
+        lines.push(format!(
+            "  {:20} {:>14.6e} +- {:.2e} {}{}{}",
+            p.parameter,
+            v,
+            e,
+            p.unit,
+            if p.determined {
+                ""
+            } else {
+                "  (NOT DETERMINED)"
+            },
+            bias
+        ));
+    }
+    lines.push(format!(
+        "  converged {}, identifiable {}, model adequate {}, {} trials",
+        s.converged, s.identifiable, s.adequacy.model_adequate, s.iterations
+    ));
+    for d in &s.diagnostics {
+        lines.push(format!(
+            "  warning: {}",
+            serde_json::to_string(d).unwrap_or_default()
+        ));
+    }
+    lines.join("\n")
+}
