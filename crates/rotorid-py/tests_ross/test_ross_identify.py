@@ -115,3 +115,78 @@ def test_refine_recovers_rosss_bearings_and_unbalances_within_three_standard_err
             total += 1
     # 95 % intervals: at least 31 of 36 cover (binomial: P(fewer) < 3 % for a true 95 %)
     assert covered >= total - 5, f"{covered} of {total}"
+
+
+def rotorid_bin() -> str:
+    return os.environ.get("ROTORID_BIN", "rotorid")
+
+
+def rms(v: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(v))))
+
+
+@pytest.fixture(scope="module")
+def summary_file(fits, scenario) -> pathlib.Path:
+    p = scenario.parent / f"summary{SEEDS[0]}.json"
+    p.write_text(json.dumps(fits[SEEDS[0]]))
+    return p
+
+
+def test_the_identified_model_predicts_rosss_response_at_the_disks(summary_file, scenario):
+    # rotorid predict: the identified model's response where no probe is, against ROSS's
+    out = scenario.parent / "pred.csv"
+    subprocess.run([rotorid_bin(), "predict", str(summary_file), "--scenario", str(scenario),
+                    "--dofs", ",".join(DISKS), "--out", str(out)], check=True, capture_output=True)
+    import pandas as pd
+    pred = pd.read_csv(out)
+    assert len(pred) == len(FIXTURE["t"])
+    np.testing.assert_allclose(pred["t"].to_numpy(), FIXTURE["t"], rtol=0, atol=1e-12)
+    for d in DISKS:
+        ross = channel(d)
+        ours = pred[d].to_numpy()
+        rel = rms(ours - ross) / rms(ross)
+        band = rms(pred[f"{d}_std"].to_numpy()) / rms(ross)
+        print(f"{d}: prediction - ROSS = {rel:.2e} of ROSS's RMS (the band's RMS {band:.1e})")
+        assert rel < 0.02, (d, rel)
+
+
+def ross_critical(rotor, guess: float) -> float:
+    """ROSS's critical speed [rad/s] near `guess`: where the damped natural frequency of the
+    mode nearest the running speed at `guess` (from ROSS's own run_modal) equals the speed,
+    by the secant method."""
+    k = int(np.argmin(np.abs(rotor.run_modal(guess).wd - guess)))
+
+    def f(w: float) -> float:
+        return float(rotor.run_modal(w).wd[k] - w)
+
+    a, b = 0.99 * guess, 1.01 * guess
+    fa, fb = f(a), f(b)
+    for _ in range(20):
+        c = b - fb * (b - a) / (fb - fa)
+        a, fa, b, fb = b, fb, c, f(c)
+        if abs(b - a) < 1e-9 * abs(b):
+            break
+    return b
+
+
+def test_updated_rotor_has_the_true_critical_speeds_within_their_std(summary_file, scenario, fits):
+    # the critical speeds, with their standard deviations, of the identified rotor
+    # (rotorid analyze SUMMARY.json: the covariance carried through), and ROSS's own of
+    # rotorid.ross.update's rotor against the true rotor's
+    out = scenario.parent / "analysis"
+    subprocess.run([rotorid_bin(), "analyze", str(summary_file), "--scenario", str(scenario),
+                    "--out", str(out), "--rpm", "0:7000:10"], check=True, capture_output=True)
+    a = json.loads((out / "analysis.json").read_text())
+    crit = a["critical_speeds"]
+    assert len(crit) >= 2, crit
+    true_rotor = two_disk_rotor()
+    updated = rr.update(true_rotor, fits[SEEDS[0]])
+    for c in crit:
+        w = c["rpm"] * math.pi / 30.0
+        std = c["std_rpm"] * math.pi / 30.0
+        t, u = ross_critical(true_rotor, w), ross_critical(updated, w)
+        print(f"{c['whirl']}: rotorid {w:.4f} +- {std:.2e} rad/s, ROSS updated {u:.4f}, "
+              f"ROSS true {t:.4f} ({(u - t) / std:+.2f} std)")
+        assert std > 0
+        assert abs(u - t) < 3.0 * std, (c, u, t)
+        assert abs(w - t) < 3.0 * std, (c, w, t)
