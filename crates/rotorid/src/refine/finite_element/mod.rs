@@ -195,7 +195,7 @@ impl FeData<'_> {
         }
         for (i, &t) in r.t.iter().enumerate() {
             let dev = t - (r.t[0] + i as f64 * dt);
-            if !(dev.abs() <= 0.3 * dt) {
+            if dev.abs().is_nan() || dev.abs() > 0.3 * dt {
                 return Err(FeRefineError::Record(format!(
                     "t at sample {i} is {t} s, {dev:e} s from the uniform grid of dt = {dt} s: \
                      the finite-element fit needs uniform times (within 0.3 dt)"
@@ -313,7 +313,7 @@ pub fn crb_fe(
         initial,
         modes,
     )?;
-    if sigma.len() != data.response.dofs.len() || sigma.iter().any(|s| !(*s > 0.0)) {
+    if sigma.len() != data.response.dofs.len() || sigma.iter().any(|s| s.is_nan() || *s <= 0.0) {
         return Err(FeRefineError::Record(format!(
             "{} noise levels for {} channels: one > 0 per channel",
             sigma.len(),

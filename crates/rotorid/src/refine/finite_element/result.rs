@@ -144,7 +144,9 @@ pub(crate) fn inverse(a: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     // scale to unit diagonal for accuracy
     let n = a.nrows();
     let d: Vec<f64> = (0..n).map(|i| a[(i, i)].max(0.0).sqrt()).collect();
-    if d.iter().any(|v| !(*v > 0.0)) {
+    if d.iter()
+        .any(|v| v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+    {
         return None;
     }
     let s = DMatrix::from_fn(n, n, |i, j| a[(i, j)] / (d[i] * d[j]));
@@ -156,8 +158,13 @@ pub(crate) fn inverse(a: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 fn conditioning(a: &DMatrix<f64>) -> (f64, DVector<f64>) {
     let n = a.nrows();
     let d: Vec<f64> = (0..n).map(|i| a[(i, i)].max(0.0).sqrt()).collect();
-    if d.iter().any(|v| !(*v > 0.0)) {
-        let i = d.iter().position(|v| !(*v > 0.0)).unwrap_or(0);
+    if d.iter()
+        .any(|v| v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+    {
+        let i = d
+            .iter()
+            .position(|v| v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+            .unwrap_or(0);
         let mut e = DVector::zeros(n);
         e[i] = 1.0;
         return (f64::INFINITY, e);
