@@ -28,6 +28,7 @@ __all__ = [
     "balance",
     "identify",
     "load_finite_element",
+    "identify_finite_element",
     "plan_trials",
     "read",
     "read_blocks",

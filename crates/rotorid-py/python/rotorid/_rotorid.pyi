@@ -6,7 +6,7 @@ import numpy as np
 
 from . import Scenario as Scenario
 
-__all__ = ["ESTIMATE_COLUMNS", "ESTIMATE_COLUMNS_BY_MODEL", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "load_finite_element", "read", "read_blocks", "read_fe_matrices", "simulate"]
+__all__ = ["ESTIMATE_COLUMNS", "ESTIMATE_COLUMNS_BY_MODEL", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "identify_finite_element", "load_finite_element", "read", "read_blocks", "read_fe_matrices", "simulate"]
 
 METHODS: list[str]
 MODELS: list[str]
