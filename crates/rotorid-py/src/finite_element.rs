@@ -58,6 +58,7 @@ pub fn identify(
     unknowns: Option<&str>,
     initial: Option<&str>,
     modes: Option<usize>,
+    offsets: bool,
 ) -> Result<String, Error> {
     use rotorid::model::finite_element::{Dof, FeParameter};
     use rotorid::refine::finite_element::{
@@ -92,6 +93,7 @@ pub fn identify(
         }
         options.modes = m;
     }
+    options.offsets = offsets;
     let mut dofs = Vec::with_capacity(channels.len());
     let mut q = Vec::with_capacity(channels.len());
     for (name, col) in channels {

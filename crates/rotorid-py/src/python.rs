@@ -413,7 +413,8 @@ fn matrix<'py>(py: Python<'py>, n: usize, row_major: Vec<f64>) -> PyResult<Bound
 /// Identify a finite-element rotor (`crate::finite_element::identify`): the summary as
 /// JSON text.
 #[pyfunction]
-#[pyo3(signature = (t, channels, scenario, unknowns=None, initial=None, modes=None))]
+#[pyo3(signature = (t, channels, scenario, unknowns=None, initial=None, modes=None, offsets=false))]
+#[allow(clippy::too_many_arguments)]
 fn identify_finite_element(
     py: Python<'_>,
     t: Vec<f64>,
@@ -422,6 +423,7 @@ fn identify_finite_element(
     unknowns: Option<String>,
     initial: Option<String>,
     modes: Option<usize>,
+    offsets: bool,
 ) -> PyResult<String> {
     let path = scenario.to_string_lossy().into_owned();
     py.detach(|| {
@@ -432,6 +434,7 @@ fn identify_finite_element(
             unknowns.as_deref(),
             initial.as_deref(),
             modes,
+            offsets,
         )
     })
     .map_err(py_err)

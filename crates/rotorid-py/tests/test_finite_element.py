@@ -75,3 +75,31 @@ def test_identify_finite_element_refuses_by_name(fe_scenario, record):
         rotorid.identify_finite_element(data, fe_scenario, modes=3)
     with pytest.raises(ValueError, match="no column t"):
         rotorid.identify_finite_element({"0.x": data["0.x"]}, fe_scenario)
+
+
+def test_offsets_absorb_a_removed_dc(fe_scenario, record):
+    # the record with a constant added to each channel (a DC removed, or a gap voltage
+    # subtracted, by the user's own conditioning): with offsets=True the fit reports the
+    # constants within their standard errors and the 2-DOF refine's estimates on the
+    # clean record (another code); without them the adequacy tests reject the fit
+    shift = {"0.x": 3e-7, "0.y": -2e-7}
+    data = {"t": record.t.to_numpy(), "0.x": record.x.to_numpy() + shift["0.x"],
+            "0.y": -record.z.to_numpy() + shift["0.y"]}
+    s = rotorid.identify_finite_element(data, fe_scenario, offsets=True)
+    assert s["converged"] and s["identifiable"] and s["adequacy"]["model_adequate"], s["diagnostics"]
+    assert [o["channel"] for o in s["offsets"]] == ["0.x", "0.y"]
+    for o in s["offsets"]:
+        assert abs(o["value"] - shift[o["channel"]]) < 4 * o["std_error"], o
+    two = rotorid.identify(record, rotorid.Scenario(**CROSS), method="refine", model="cross_coupled",
+                           unknowns=["cxx", "czz", "kxx", "kzz", "unbalance"])
+    ref = {p["parameter"]: p for p in two.to_dict()["parameters"]}
+    got = {p["parameter"]: p for p in s["parameters"]}
+    for fe, xz, shift_angle in [("bearing0.kxx", "kxx", 0.0), ("bearing0.kyy", "kzz", 0.0),
+                                ("bearing0.cxx", "cxx", 0.0), ("bearing0.cyy", "czz", 0.0),
+                                ("unbalance0.mud", "mud", 0.0),
+                                ("unbalance0.alpha", "alpha", -math.pi / 2)]:
+        a, b = got[fe], ref[xz]
+        assert abs(a["value"] - (b["estimate"] + shift_angle)) < 0.5 * a["std_error"], (fe, a, b)
+    plain = rotorid.identify_finite_element(data, fe_scenario)
+    assert "offsets" not in plain
+    assert not plain["adequacy"]["model_adequate"]

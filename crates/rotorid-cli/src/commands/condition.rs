@@ -93,14 +93,7 @@ fn condition_finite_element(args: &ConditionArgs, spec: &ScenarioSpec) -> anyhow
     let raw = tables::fe_raw_record(&table, acq)?;
     let slow = tables::fe_slow_roll(spec, acq)?;
     let c = rotorid::acquisition::condition_fe_raw(&raw, acq, slow.as_ref())?;
-    for (node, report) in &c.reports {
-        for n in &report.notes {
-            eprintln!("note: node {node}: {n}");
-        }
-        for f in &report.findings {
-            eprintln!("warning: node {node}: {}", f.message());
-        }
-    }
+    print_fe_reports(&c.reports);
     if let Some(path) = &args.report {
         let mut f = Output::create(path, FileMode::Atomic)?;
         serde_json::to_writer_pretty(&mut f, &c.reports)
@@ -109,4 +102,16 @@ fn condition_finite_element(args: &ConditionArgs, spec: &ScenarioSpec) -> anyhow
     }
     let table = crate::io::fe_response::fe_table(&args.out, c.response);
     crate::commands::simulate::write_any(&args.out, &table)
+}
+
+/// Each node's conditioning notes and findings on stderr.
+pub(crate) fn print_fe_reports(reports: &[(u32, rotorid::acquisition::ConditionReport)]) {
+    for (node, report) in reports {
+        for n in &report.notes {
+            eprintln!("note: node {node}: {n}");
+        }
+        for f in &report.findings {
+            eprintln!("warning: node {node}: {}", f.message());
+        }
+    }
 }

@@ -25,6 +25,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     for (flag, given) in [
         ("--initial", args.initial.is_some()),
         ("--modes", args.modes.is_some()),
+        ("--offsets", args.offsets),
     ] {
         if given {
             anyhow::bail!(

@@ -11,7 +11,7 @@ use crate::finite_element::{columns, scenarios};
 
 /// A two-node rotor (x, y at nodes 0 and 1): 2 kg and 3 kg joined by a shaft spring, a
 /// gyroscopic coupling at node 1, a bearing at each node, an unbalance at node 1.
-fn two_node(dir: &std::path::Path, acquisition: &str) -> String {
+pub(crate) fn two_node(dir: &std::path::Path, acquisition: &str) -> String {
     let (k, g) = (2.0e6, 0.01);
     #[rustfmt::skip]
     let kk = vec![
@@ -59,7 +59,7 @@ fn two_node(dir: &std::path::Path, acquisition: &str) -> String {
 
 /// Probes at node 1 (0 and 90 deg; the second wired the other way: s < 0) and node 0 (45
 /// and 135 deg), in that order in the file; the keyphasor at phi = 0.
-const PROBES: &str = "[acquisition]\ntime = \"t\"\n\
+pub(crate) const PROBES: &str = "[acquisition]\ntime = \"t\"\n\
     [[acquisition.probe]]\ncolumn = \"b1\"\nnode = 1\nangle_deg = 0.0\nsensitivity = 7874.0\n\
     [[acquisition.probe]]\ncolumn = \"a0\"\nnode = 0\nangle_deg = 45.0\nsensitivity = 7874.0\n\
     [[acquisition.probe]]\ncolumn = \"b2\"\nnode = 1\nangle_deg = 90.0\nsensitivity = -7874.0\n\

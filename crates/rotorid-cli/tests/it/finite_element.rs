@@ -167,7 +167,7 @@ fn noise_is_reproducible_and_two_dof_options_are_refused() {
 }
 
 /// The value of `name` in a summary's parameters.
-fn param<'a>(s: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+pub(crate) fn param<'a>(s: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
     s["parameters"]
         .as_array()
         .unwrap()
@@ -334,6 +334,20 @@ fn identify_of_a_finite_element_rotor_refuses_what_does_not_apply_by_name() {
     ]);
     assert!(
         e.contains("--initial applies to a finite-element rotor only"),
+        "{e}"
+    );
+    let e = run(&[
+        r,
+        "--scenario",
+        &cross,
+        "--method",
+        "refine",
+        "--offsets",
+        "--out",
+        "-",
+    ]);
+    assert!(
+        e.contains("--offsets applies to a finite-element rotor only"),
         "{e}"
     );
     let e = run(&[

@@ -12,6 +12,7 @@ mod dashboard_browser;
 mod demo;
 mod fe_analyze;
 mod fe_data;
+mod fe_raw_identify;
 mod finite_element;
 mod fleet;
 mod formats;

@@ -138,6 +138,7 @@ def identify_finite_element(
     unknowns: str | Sequence[str] | None = None,
     initial: str = "estimated",
     modes: int | None = None,
+    offsets: bool = False,
 ) -> dict[str, Any]:
     """Identify the bearings and unbalances of a finite-element rotor, as ``rotorid
     identify DATA --scenario S.toml --method refine`` does (docs/finite_element.md
@@ -155,6 +156,9 @@ def identify_finite_element(
             unbalance.
         initial: ``"rest"`` (the record starts at rest) or ``"estimated"``.
         modes: modes of the Ritz basis (``None``: 6).
+        offsets: fit one constant offset per channel (data = response + offset + noise),
+            for channels whose DC was removed (a mean or a gap voltage subtracted, as a
+            conditioning without a rotor model does); reported under ``offsets``.
 
     Returns the summary as a dict (docs/summary.md, "Finite-element rotors"): each
     unknown with its standard error under ``parameters``, the covariance, the rotor with
@@ -182,7 +186,8 @@ def identify_finite_element(
     else:
         u = ",".join(unknowns)
     t = np.asarray(get("t"), dtype=np.float64).tolist()
-    text = _rotorid.identify_finite_element(t, channels, os.fspath(scenario), u, initial, modes)
+    text = _rotorid.identify_finite_element(
+        t, channels, os.fspath(scenario), u, initial, modes, bool(offsets))
     return json.loads(text)
 
 

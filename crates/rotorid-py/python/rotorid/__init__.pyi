@@ -195,4 +195,5 @@ def identify_finite_element(
     unknowns: str | Sequence[str] | None = None,
     initial: str = "estimated",
     modes: int | None = None,
+    offsets: bool = False,
 ) -> dict[str, Any]: ...

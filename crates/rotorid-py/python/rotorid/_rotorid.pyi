@@ -38,6 +38,7 @@ def identify_finite_element(
     unknowns: str | None = None,
     initial: str | None = None,
     modes: int | None = None,
+    offsets: bool = False,
 ) -> str: ...
 @final
 class Blocks:

@@ -48,7 +48,16 @@ fn from_rest(label: &str, speed: SpeedProfile, duration: f64, seed: u64) {
     let t0 = std::time::Instant::now();
     let mut fit = refine_fe(&data, &guess(&truth), &options).unwrap();
     eprintln!("{label}, 40 dB, fit in {:?}", t0.elapsed());
-    let crb = crb_fe(&data, &truth, &options.unknowns, FeInitial::Rest, &sigma, 8).unwrap();
+    let crb = crb_fe(
+        &data,
+        &truth,
+        &FeRefineOptions {
+            modes: 8,
+            ..options.clone()
+        },
+        &sigma,
+    )
+    .unwrap();
     fit.attach_crb(&crb);
     let worst = report(&fit, &truth);
     assert!(fit.converged && fit.identifiable, "{:?}", fit.warnings);

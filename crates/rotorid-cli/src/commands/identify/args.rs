@@ -196,9 +196,17 @@ pub struct IdentifyArgs {
     pub initial: Option<String>,
 
     /// Finite-element rotors only: modes in the Ritz basis of the reduced model (with the
-    /// static shapes at the bearing and unbalance nodes) [default: 8].
+    /// static shapes at the bearing and unbalance nodes) [default: 6, at most the degrees
+    /// of freedom].
     #[arg(long, value_name = "N")]
     pub modes: Option<usize>,
+
+    /// Finite-element rotors only: fit one constant offset per channel with the parameters
+    /// (data = response + offset + noise), for a response whose DC was removed (a mean or
+    /// a gap voltage subtracted). Always on for a raw record (the scenario's
+    /// [acquisition]), whose conditioning leaves the mean of the motion in each DC.
+    #[arg(long)]
+    pub offsets: bool,
 }
 
 /// The method's settings, shared by `rotorid identify` and `rotorid worker` (each checked

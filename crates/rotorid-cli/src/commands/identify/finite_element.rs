@@ -59,17 +59,7 @@ pub fn run(args: &IdentifyArgs, spec: &ScenarioSpec) -> anyhow::Result<()> {
         }
         options.modes = m;
     }
-    if spec.fe_acquisition().is_some() {
-        bail!(
-            "{}: identifying a raw finite-element acquisition is not available yet: condition \
-             it with `rotorid condition {} --scenario {}` and mind that each conditioned \
-             channel keeps a constant offset (the mean of a start-up transient), which the \
-             finite-element fit does not model",
-            spec.origin(),
-            args.input,
-            args.scenario
-        );
-    }
+    options.offsets = args.offsets;
     let Some(&speed) = spec.speed_profile() else {
         bail!(
             "{}: a finite-element identification needs the scenario's [speed] (kind = \
@@ -78,29 +68,46 @@ pub fn run(args: &IdentifyArgs, spec: &ScenarioSpec) -> anyhow::Result<()> {
             spec.origin()
         );
     };
-    let data: FeResponse = crate::io::fe_response::read_fe_response(
-        &args.input,
-        &start,
-        Some(&speed),
-        args.time_tolerance,
-    )?;
-    // a record's own speed columns must be the profile the model is driven by
-    if let Some(i) = (0..data.len()).find(|&i| {
-        let s = speed.at(data.t[i] - data.t[0]);
-        (data.phi_dot[i] - s.omega).abs() > 1e-6 * s.omega.abs().max(1.0)
-    }) {
-        let s = speed.at(data.t[i] - data.t[0]);
-        bail!(
-            "{}: phi_dot at t = {} s is {} rad/s but the scenario's [speed] gives {} rad/s \
-             there: the finite-element fit is driven by the [speed] profile (from the record's \
-             first sample), so the record's speed must follow it (within 1e-6); measured \
-             speed is not used yet",
-            args.input,
-            data.t[i],
-            data.phi_dot[i],
-            s.omega
-        );
-    }
+    let data: FeResponse =
+        if let Some(acq) = crate::io::finite_element::fe_acquisition_of(spec, &start)? {
+            // a raw acquisition: each node's probes conditioned without a rotor guess, so
+            // each channel keeps the mean of the motion over the record's revolutions in
+            // its DC: one constant offset per channel is fitted with the parameters
+            let table = crate::io::tables::read(&args.input)?;
+            let raw = crate::io::tables::fe_raw_record(&table, acq)?;
+            let slow = crate::io::tables::fe_slow_roll(spec, acq)?;
+            let c = rotorid::acquisition::condition_fe_raw(&raw, acq, slow.as_ref())
+                .with_context(|| args.input.clone())?;
+            crate::commands::condition::print_fe_reports(&c.reports);
+            check_keyphasor_speed(&args.input, &c.response, &speed)?;
+            options.offsets = true;
+            c.response
+        } else {
+            let data = crate::io::fe_response::read_fe_response(
+                &args.input,
+                &start,
+                Some(&speed),
+                args.time_tolerance,
+            )?;
+            // a record's own speed columns must be the profile the model is driven by
+            if let Some(i) = (0..data.len()).find(|&i| {
+                let s = speed.at(data.t[i] - data.t[0]);
+                (data.phi_dot[i] - s.omega).abs() > 1e-6 * s.omega.abs().max(1.0)
+            }) {
+                let s = speed.at(data.t[i] - data.t[0]);
+                bail!(
+                    "{}: phi_dot at t = {} s is {} rad/s but the scenario's [speed] gives {} \
+                     rad/s there: the finite-element fit is driven by the [speed] profile \
+                     (from the record's first sample), so the record's speed must follow it \
+                     (within 1e-6); measured speed is not used yet",
+                    args.input,
+                    data.t[i],
+                    data.phi_dot[i],
+                    s.omega
+                );
+            }
+            data
+        };
     let fe = FeData {
         response: &data,
         speed,
@@ -147,6 +154,39 @@ fn ryu_like(v: f64) -> String {
     format!("{v:e}")
 }
 
+/// Largest RMS deviation of a raw record's keyphasor speed from the scenario's profile
+/// that is accepted, relative to the profile's RMS speed.
+const KEYPHASOR_SPEED_TOLERANCE: f64 = 1e-3;
+
+/// A raw record's speed from its keyphasor must follow the scenario's [speed] profile the
+/// model is driven by: the RMS of (phi_dot - profile) over the RMS of the profile within
+/// [`KEYPHASOR_SPEED_TOLERANCE`] (the keyphasor's speed interpolates between its events, so
+/// it is compared as a whole, not sample by sample).
+fn check_keyphasor_speed(
+    input: &str,
+    data: &FeResponse,
+    speed: &rotorid::model::SpeedProfile,
+) -> anyhow::Result<()> {
+    let (mut d2, mut s2) = (0.0, 0.0);
+    for (t, w) in data.t.iter().zip(&data.phi_dot) {
+        let s = speed.at(t - data.t[0]).omega;
+        d2 += (w - s) * (w - s);
+        s2 += s * s;
+    }
+    let n = data.len().max(1) as f64;
+    let (d, s) = ((d2 / n).sqrt(), (s2 / n).sqrt());
+    if d.is_nan() || d > KEYPHASOR_SPEED_TOLERANCE * s.max(1.0) {
+        bail!(
+            "{input}: the keyphasor's speed departs from the scenario's [speed] profile by \
+             {d:.4e} rad/s RMS ({:.2e} of its RMS {s:.4e} rad/s; allowed {KEYPHASOR_SPEED_TOLERANCE:e}): \
+             the finite-element fit is driven by the [speed] profile from the record's first \
+             sample, so set [speed] to the speed the record was taken at",
+            d / s.max(1.0)
+        );
+    }
+    Ok(())
+}
+
 /// The human report: each parameter with its standard error, the fit's verdicts.
 fn report(s: &FeSummary) -> String {
     let mut lines = vec![format!(
@@ -161,6 +201,12 @@ fn report(s: &FeSummary) -> String {
         s.reduction.size,
         s.reduction.full
     )];
+    for o in s.offsets.iter().flatten() {
+        lines.push(format!(
+            "  offset of {:11} {:>14.6e} +- {:.2e} m (the conditioned channel's DC)",
+            o.channel, o.value, o.std_error
+        ));
+    }
     for p in &s.parameters {
         let v = p.estimate.unwrap_or(f64::NAN);
         let e = p.std_error.unwrap_or(f64::INFINITY);

@@ -26,7 +26,9 @@ pub struct FeProblem {
     modes: usize,
     method: FeMethod,
     /// 2r when the initial state is estimated, else 0.
-    nuisance: usize,
+    states: usize,
+    /// One constant offset per channel estimated (after the initial state).
+    offsets: bool,
 }
 
 /// The response at the measured channels on every k-th sample, and its sensitivities.
@@ -34,7 +36,8 @@ pub struct FeProblem {
 pub(crate) struct Evaluation {
     /// y\[c\]\[i\]: channel c at sample i k.
     pub(crate) y: Vec<Vec<f64>>,
-    /// jac\[j\]\[c\]\[i\]: d y\[c\]\[i\] / d theta_j (unknowns, then the initial state).
+    /// jac\[j\]\[c\]\[i\]: d y\[c\]\[i\] / d theta_j (unknowns, then the initial state,
+    /// then the channels' offsets).
     pub(crate) jac: Vec<Vec<Vec<f64>>>,
     /// The decimation k.
     pub(crate) k: usize,
@@ -93,11 +96,30 @@ impl FeProblem {
             } else {
                 FeMethod::Magnus
             },
-            nuisance: match initial {
+            states: match initial {
                 FeInitial::Rest => 0,
                 FeInitial::Estimated => 2 * r,
             },
+            offsets: false,
         })
+    }
+
+    /// The same problem with one constant offset per channel estimated (`on`) or not: a
+    /// conditioned raw record keeps the mean of the motion over its revolutions in each
+    /// probe's DC, so its channels are the motion less an unknown constant.
+    pub fn with_offsets(mut self, on: bool) -> Self {
+        self.offsets = on;
+        self
+    }
+
+    /// Whether each channel's constant offset is estimated.
+    pub fn offsets(&self) -> bool {
+        self.offsets
+    }
+
+    /// The number of initial-state unknowns (0 or 2r), first among the nuisance ones.
+    pub fn states(&self) -> usize {
+        self.states
     }
 
     /// The unknown parameters, in order.
@@ -105,9 +127,10 @@ impl FeProblem {
         &self.unknowns
     }
 
-    /// The number of initial-state unknowns (0 or 2r).
+    /// The number of nuisance unknowns: the initial state (0 or 2r) then, when estimated,
+    /// one offset per channel.
     pub fn nuisance(&self) -> usize {
-        self.nuisance
+        self.states + if self.offsets { self.outputs.len() } else { 0 }
     }
 
     /// Modes in the basis.
@@ -160,9 +183,10 @@ impl FeProblem {
         Ok(q)
     }
 
-    /// The response of `rotor` (reduced to `basis`) from the initial state `x0` (reduced
-    /// coordinates; ignored at rest) on every k-th of the first n samples (`at` = (k, n)),
-    /// with the sensitivities when `jacobian`.
+    /// The response of `rotor` (reduced to `basis`) from the initial state in `x0` (its
+    /// first [`states`](Self::states) entries, reduced coordinates; none at rest) plus the
+    /// channels' offsets (its last entries, when estimated) on every k-th of the first n
+    /// samples (`at` = (k, n)), with the sensitivities when `jacobian`.
     pub(crate) fn evaluate(
         &self,
         rotor: &FiniteElementRotor,
@@ -191,11 +215,11 @@ impl FeProblem {
             units.push(pair);
         }
         // free responses of each reduced initial coordinate
-        let mut free = Vec::with_capacity(self.nuisance);
-        if self.nuisance > 0 {
+        let mut free = Vec::with_capacity(self.states);
+        if self.states > 0 {
             sys.update(&unit)?;
-            for i in 0..self.nuisance {
-                let mut e = DVector::zeros(self.nuisance);
+            for i in 0..self.states {
+                let mut e = DVector::zeros(self.states);
                 e[i] = 1.0;
                 let init = full_initial(basis, &e);
                 free.push(self.simulate(&sys, at, Some(&init))?);
@@ -225,9 +249,15 @@ impl FeProblem {
         for (i, f) in free.iter().enumerate() {
             combine(&mut y, x0[i], f);
         }
+        if self.offsets {
+            for (c, yc) in y.iter_mut().enumerate() {
+                let o = x0[self.states + c];
+                yc.iter_mut().for_each(|v| *v += o);
+            }
+        }
         let mut jac = Vec::new();
         if jacobian {
-            let init = (self.nuisance > 0).then(|| full_initial(basis, x0));
+            let init = (self.states > 0).then(|| full_initial(basis, x0));
             for &p in &self.unknowns {
                 let mut col = vec![vec![0.0; len]; nc];
                 match p {
@@ -238,9 +268,15 @@ impl FeProblem {
                         p.set(&mut moved, v + h);
                         sys.update(&moved)?;
                         let yp = self.simulate(&sys, at, init.as_ref())?;
-                        for ((cc, ypc), yc) in col.iter_mut().zip(&yp).zip(&y) {
-                            for ((o, a), b) in cc.iter_mut().zip(ypc).zip(yc) {
-                                *o = (a - b) / h;
+                        for (c, ((cc, ypc), yc)) in col.iter_mut().zip(&yp).zip(&y).enumerate() {
+                            // y holds the offsets, the moved response does not
+                            let o = if self.offsets {
+                                x0[self.states + c]
+                            } else {
+                                0.0
+                            };
+                            for ((d, a), b) in cc.iter_mut().zip(ypc).zip(yc) {
+                                *d = (a + o - b) / h;
                             }
                         }
                     }
@@ -259,6 +295,13 @@ impl FeProblem {
                 jac.push(col);
             }
             jac.extend(free);
+            if self.offsets {
+                for c in 0..nc {
+                    let mut col = vec![vec![0.0; len]; nc];
+                    col[c].fill(1.0);
+                    jac.push(col);
+                }
+            }
         }
         Ok(Evaluation { y, jac, k, units })
     }

@@ -17,7 +17,10 @@
 //!
 //! **Unknowns.** Any subset of the bearing coefficients and the unbalances
 //! ([`FeParameter`]), plus, unless the record starts at rest ([`FeInitial::Rest`]), the
-//! initial state in the reduced coordinates (2r nuisance parameters).
+//! initial state in the reduced coordinates (2r nuisance parameters), plus, on request
+//! ([`FeRefineOptions::offsets`]), one constant offset per channel (a conditioned raw
+//! record keeps the mean of the motion over its revolutions in each probe's DC). Both
+//! nuisances enter linearly and are solved for at every step (variable projection).
 //!
 //! **Sensitivities.** The response is linear in each unbalance's complex amplitude U_j =
 //! mud_j e^{i alpha_j} and in the initial state: y = sum_j (Re U_j Y_j + Im U_j Y'_j) +
@@ -56,7 +59,7 @@ use crate::simulate::finite_element::{FeInitialState, FeResponse};
 use crate::simulate::SimulateError;
 
 pub use evaluate::FeProblem;
-pub use result::{FeFittedValue, FeReduction, FeRefined, FeWarning};
+pub use result::{FeFittedValue, FeOffset, FeReduction, FeRefined, FeWarning};
 pub use summary::{
     FeAdequacy, FeBearingSummary, FeCovariance, FeInitialStateSummary, FeNoise, FeParameterSummary,
     FeRecordSummary, FeRotorSummary, FeSummary, FeUnbalanceSummary,
@@ -106,6 +109,10 @@ pub struct FeRefineOptions {
     pub coarse: usize,
     /// Simulate the full model once at the estimate to measure the reduction's bias.
     pub reduction_bias: bool,
+    /// Estimate one constant offset per channel (data = response + offset + noise): for
+    /// a record conditioned from raw probes without a rotor guess, whose channels keep the
+    /// mean of the motion over the record's revolutions. Off by default.
+    pub offsets: bool,
 }
 
 impl FeRefineOptions {
@@ -120,6 +127,7 @@ impl FeRefineOptions {
             tolerance: 1e-2,
             coarse: 8,
             reduction_bias: true,
+            offsets: false,
         }
     }
 }
@@ -244,7 +252,8 @@ pub fn refine_fe(
         options.unknowns.clone(),
         options.initial,
         options.modes,
-    )?;
+    )?
+    .with_offsets(options.offsets);
     let np = problem.unknowns().len();
     let nuisance = problem.nuisance();
     if np + nuisance == 0 {
@@ -289,30 +298,32 @@ pub fn refine_fe(
     result::finish(&problem, &y, fit, trials, converged, options)
 }
 
-/// The Cramer-Rao bound of `unknowns` for a record like `data` (its channels, sampling and
-/// speed; its values are not used) of the rotor `truth` with noise `sigma[c]` \[m or rad\]
-/// on channel c, initial state rest or `x0` (reduced coordinates of `truth`'s basis with
-/// `modes` modes): sqrt of the diagonal of the inverse Fisher information, in the order of
-/// `unknowns` (+infinity when singular).
+/// The Cramer-Rao bound of `options.unknowns` for a record like `data` (its channels,
+/// sampling and speed; its values are not used) of the rotor `truth` from rest, with noise
+/// `sigma[c]` \[m or rad\] on channel c, the nuisances of `options` (initial state,
+/// offsets) unknown as in the fit, the basis of `options.modes` modes: sqrt of the diagonal
+/// of the inverse Fisher information, in the order of the unknowns (+infinity when
+/// singular).
 pub fn crb_fe(
     data: &FeData,
     truth: &FiniteElementRotor,
-    unknowns: &[FeParameter],
-    initial: FeInitial,
+    options: &FeRefineOptions,
     sigma: &[f64],
-    modes: usize,
 ) -> Result<Vec<f64>, FeRefineError> {
     let dt = data.checked_dt()?;
+    let unknowns = &options.unknowns;
+    let modes = options.modes;
     let problem = FeProblem::new(
         truth,
         data.response.dofs.clone(),
         data.speed,
         dt,
         data.response.len(),
-        unknowns.to_vec(),
-        initial,
+        unknowns.clone(),
+        options.initial,
         modes,
-    )?;
+    )?
+    .with_offsets(options.offsets);
     if sigma.len() != data.response.dofs.len() || sigma.iter().any(|s| s.is_nan() || *s <= 0.0) {
         return Err(FeRefineError::Record(format!(
             "{} noise levels for {} channels: one > 0 per channel",

@@ -33,6 +33,17 @@ pub struct FeFittedValue {
     pub reduction_bias_std: Option<f64>,
 }
 
+/// A channel's fitted constant offset: data = model response + offset + noise.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FeOffset {
+    /// The channel (`<node>.<dof>`).
+    pub channel: String,
+    /// The offset \[m or rad, the channel's unit\].
+    pub value: f64,
+    /// Its standard error \[same unit\] (+infinity when not determined).
+    pub std_error: f64,
+}
+
 /// A diagnostic of a finite-element fit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -98,6 +109,9 @@ pub struct FeRefined {
     pub initial: FeInitial,
     /// The fitted initial state in full coordinates (None at rest).
     pub initial_state: Option<FeInitialState>,
+    /// Each channel's fitted constant offset, when estimated
+    /// ([`FeRefineOptions::offsets`](super::FeRefineOptions::offsets)).
+    pub offsets: Option<Vec<FeOffset>>,
     /// The channels, with the noise standard deviation estimated from the residuals \[m or
     /// rad\].
     pub noise: Vec<(Dof, f64)>,
@@ -228,8 +242,10 @@ pub(crate) fn finish(
             .map(|(i, v)| {
                 let name = if i < np {
                     problem.unknowns()[i].to_string()
-                } else {
+                } else if i < np + problem.states() {
                     format!("initial state {}", i - np)
+                } else {
+                    format!("offset of {}", problem.outputs()[i - np - problem.states()])
                 };
                 (-v.abs(), name)
             })
@@ -275,8 +291,14 @@ pub(crate) fn finish(
     let mut max_bias = None;
     if options.reduction_bias {
         let full = full_system(&fit.rotor);
-        let init = (problem.nuisance() > 0).then(|| full_initial(fit.basis.matrix(), &fit.x0));
-        let yf = problem.simulate(&full, (1, problem.samples()), init.as_ref())?;
+        let init = (problem.states() > 0).then(|| full_initial(fit.basis.matrix(), &fit.x0));
+        let mut yf = problem.simulate(&full, (1, problem.samples()), init.as_ref())?;
+        if problem.offsets() {
+            for (c, yc) in yf.iter_mut().enumerate() {
+                let o = fit.x0[problem.states() + c];
+                yc.iter_mut().for_each(|v| *v += o);
+            }
+        }
         let (mut num, mut den) = (0.0, 0.0);
         let mut shift = Evaluation {
             y: Vec::new(),
@@ -348,11 +370,36 @@ pub(crate) fn finish(
         .map(|(d, w)| (*d, 1.0 / w.sqrt()))
         .collect();
     let model_adequate = adequacy.iter().all(|(_, a)| a.adequate);
-    let initial_state = (problem.nuisance() > 0).then(|| full_initial(fit.basis.matrix(), &fit.x0));
+    let initial_state = (problem.states() > 0).then(|| full_initial(fit.basis.matrix(), &fit.x0));
+    // the channels' offsets with their standard errors (marginal, from the full covariance)
+    let offsets = problem.offsets().then(|| {
+        let at = np + problem.states();
+        problem
+            .outputs()
+            .iter()
+            .enumerate()
+            .map(|(c, d)| {
+                let v = cov_all
+                    .as_ref()
+                    .filter(|_| identifiable)
+                    .map_or(f64::INFINITY, |m| m[(at + c, at + c)]);
+                FeOffset {
+                    channel: d.to_string(),
+                    value: fit.x0[at - np + c],
+                    std_error: if v.is_finite() && v >= 0.0 {
+                        v.sqrt()
+                    } else {
+                        f64::INFINITY
+                    },
+                }
+            })
+            .collect()
+    });
     Ok(super::FeRefined {
         parameters,
         initial: problem.initial(),
         initial_state,
+        offsets,
         noise,
         samples: problem.samples(),
         iterations: trials,

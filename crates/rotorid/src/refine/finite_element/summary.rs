@@ -6,7 +6,7 @@
 
 use serde::Serialize;
 
-use super::{FeInitial, FeReduction, FeRefined, FeWarning};
+use super::{FeInitial, FeOffset, FeReduction, FeRefined, FeWarning};
 use crate::pipeline::{ChannelAdequacy, IDENTIFICATION_SCHEMA};
 
 /// The summary (module doc). Non-finite numbers are written as null.
@@ -28,6 +28,10 @@ pub struct FeSummary {
     pub initial: FeInitial,
     /// The fitted initial state (full coordinates), null at rest.
     pub initial_state: Option<FeInitialStateSummary>,
+    /// Each channel's fitted constant offset \[m or rad\] with its standard error (null:
+    /// infinite), when estimated (a record conditioned from raw probes); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub offsets: Option<Vec<FeOffset>>,
     /// One entry per unknown, in the order of the unknowns.
     pub parameters: Vec<FeParameterSummary>,
     /// Every bearing and unbalance with the identified values in.
@@ -245,6 +249,7 @@ impl FeSummary {
                 q: s.q.iter().copied().collect(),
                 v: s.v.iter().copied().collect(),
             }),
+            offsets: fit.offsets.clone(),
             parameters,
             rotor: FeRotorSummary {
                 bearings: r
