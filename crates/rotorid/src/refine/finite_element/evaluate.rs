@@ -63,7 +63,13 @@ impl FeProblem {
             if rotor.matrices.index(*d).is_none() {
                 return Err(FeRefineError::Record(format!(
                     "channel {d} is not a degree of freedom of the matrices (they have {})",
-                    super::channel_names(rotor.matrices.dofs()).join(", ")
+                    rotor
+                        .matrices
+                        .dofs()
+                        .iter()
+                        .map(Dof::to_string)
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )));
             }
         }

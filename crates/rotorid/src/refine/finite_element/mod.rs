@@ -52,7 +52,7 @@ mod summary;
 use nalgebra::{DMatrix, DVector};
 
 use crate::model::finite_element::{
-    Dof, FeParameter, FeSystem, FiniteElementError, FiniteElementRotor, RitzBasis,
+    FeParameter, FiniteElementError, FiniteElementRotor, RitzBasis,
 };
 use crate::model::{ModelError, SpeedProfile};
 use crate::simulate::finite_element::{FeInitialState, FeResponse};
@@ -589,14 +589,4 @@ pub(crate) fn full_initial(basis: &DMatrix<f64>, x0: &DVector<f64>) -> FeInitial
         q: basis * x0.rows(0, r),
         v: basis * x0.rows(r, r),
     }
-}
-
-/// Names of the measured channels.
-pub(crate) fn channel_names(dofs: &[Dof]) -> Vec<String> {
-    dofs.iter().map(|d| d.to_string()).collect()
-}
-
-/// The full system of `rotor` (for the reduction's bias).
-pub(crate) fn full_system(rotor: &FiniteElementRotor) -> FeSystem {
-    FeSystem::full(rotor)
 }

@@ -4,7 +4,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 use super::evaluate::{normal_equations, Evaluation};
-use super::{full_initial, full_system, FeInitial, FeProblem, FeRefineError, FeRefineOptions, Fit};
+use super::{full_initial, FeInitial, FeProblem, FeRefineError, FeRefineOptions, Fit};
 use crate::model::finite_element::{Dof, FeParameter, FiniteElementRotor};
 use crate::pipeline::ChannelAdequacy;
 use crate::refine::CONDITION_LIMIT;
@@ -290,7 +290,7 @@ pub(crate) fn finish(
     let mut relative_error = None;
     let mut max_bias = None;
     if options.reduction_bias {
-        let full = full_system(&fit.rotor);
+        let full = crate::model::finite_element::FeSystem::full(&fit.rotor);
         let init = (problem.states() > 0).then(|| full_initial(fit.basis.matrix(), &fit.x0));
         let mut yf = problem.simulate(&full, (1, problem.samples()), init.as_ref())?;
         if problem.offsets() {
