@@ -764,6 +764,16 @@ pub fn condition(
             g.resolution, g.max_deviation, g.dt
         ));
     }
+    let r = probes::noise_correlation(angles)?;
+    if r.abs() > 0.1 {
+        notes.push(format!(
+            "the probes are {:.0} deg apart: the conditioned x and z carry correlated noise \
+             (correlation {r:+.2} for equal probe noise); identification weighs each channel \
+             as independent, so its standard errors are approximate (probes at right angles \
+             avoid it)",
+            probes::separation_deg(angles[0], angles[1])
+        ));
+    }
     let mut findings = Vec::new();
     if !sa.report.missed_pulses_before_s.is_empty() || !sa.report.spurious_pulses_s.is_empty() {
         findings.push(AcquisitionFinding::KeyphasorRepaired {

@@ -57,6 +57,16 @@ pub fn inverse_projection(angles: [f64; 2]) -> Result<Matrix2<f64>, AcquisitionE
         .expect("separation >= 30 deg makes P invertible"))
 }
 
+/// The correlation of the conditioned x and z noises when the two probes at `angles`
+/// \[rad\] carry independent noises of equal level: the off-diagonal of
+/// P^-1 P^-T over the root of its diagonal (0 for probes at right angles, cos of the
+/// separation in magnitude otherwise).
+pub fn noise_correlation(angles: [f64; 2]) -> Result<f64, AcquisitionError> {
+    let inv = inverse_projection(angles)?;
+    let c = inv * inv.transpose();
+    Ok(c[(0, 1)] / (c[(0, 0)] * c[(1, 1)]).sqrt())
+}
+
 /// Displacement towards a probe at `angle` \[rad\] for shaft displacement (x, z) \[m\].
 #[inline]
 pub fn toward(angle: f64, x: f64, z: f64) -> f64 {
@@ -67,6 +77,34 @@ pub fn toward(angle: f64, x: f64, z: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn noise_correlation_is_the_closed_form_of_the_normal_matrix() {
+        // Cov(x, z) = sigma^2 (P^T P)^-1 with P^T P = [[c1^2 + c2^2, c1 s1 + c2 s2], [.,
+        // s1^2 + s2^2]], so r = -(c1 s1 + c2 s2) / sqrt((c1^2 + c2^2)(s1^2 + s2^2))
+        for (a1, a2) in [
+            (45.0f64, 135.0f64),
+            (0.0, 90.0),
+            (60.0, 120.0),
+            (0.0, 30.0),
+            (10.0, 140.0),
+            (200.0, 250.0),
+        ] {
+            let (s1, c1) = a1.to_radians().sin_cos();
+            let (s2, c2) = a2.to_radians().sin_cos();
+            let r = -(c1 * s1 + c2 * s2) / ((c1 * c1 + c2 * c2) * (s1 * s1 + s2 * s2)).sqrt();
+            let got = noise_correlation([a1.to_radians(), a2.to_radians()]).unwrap();
+            assert!((got - r).abs() < 1e-12, "{a1} {a2}: {got} vs {r}");
+        }
+        // at right angles, whatever the orientation, none
+        assert!(
+            noise_correlation([0.3, 0.3 + std::f64::consts::FRAC_PI_2])
+                .unwrap()
+                .abs()
+                < 1e-12
+        );
+        assert!((noise_correlation([0.0, 30f64.to_radians()]).unwrap() + 0.6547).abs() < 1e-4);
+    }
 
     #[test]
     fn inversion_recovers_x_and_z_for_any_admissible_pair() {

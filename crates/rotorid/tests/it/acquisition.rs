@@ -407,3 +407,58 @@ fn unusable_inputs_are_errors_that_name_what_is_wrong() {
         other => panic!("{other:?}"),
     }
 }
+
+#[test]
+fn probes_not_at_right_angles_are_noted_with_the_noise_correlation_they_cause() {
+    // probes 40 deg apart, no white noise: only each probe's own quantisation (10 bits over
+    // 24 V, 3 um steps at 7874 V/m: independent per probe), so the conditioned x, z errors
+    // correlate as the inverse projection says; the note states that correlation
+    let s = scenario(false, 1.0);
+    let mut acq = Acquisition::example();
+    acq.probes[0].angle = 20f64.to_radians();
+    acq.probes[1].angle = 60f64.to_radians();
+    acq.simulate.snr_db = None;
+    acq.simulate.bits = Some(10);
+    acq.simulate.runout = [Vec::new(), Vec::new()];
+    acq.simulate.slow_roll_rpm = 0.0;
+    let raw = simulate_raw(&s, &acq).unwrap();
+    let c = condition(&raw.running, &acq, None, Some(&guess(&s))).unwrap();
+    let r =
+        rotorid::acquisition::probes::noise_correlation([acq.probes[0].angle, acq.probes[1].angle])
+            .unwrap();
+    let ex: Vec<f64> = c.x.iter().zip(&raw.truth.x).map(|(a, b)| a - b).collect();
+    let ez: Vec<f64> = c.z.iter().zip(&raw.truth.z).map(|(a, b)| a - b).collect();
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let (mx, mz) = (mean(&ex), mean(&ez));
+    let cov = |a: &[f64], ma: f64, b: &[f64], mb: f64| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - ma) * (y - mb))
+            .sum::<f64>()
+            / a.len() as f64
+    };
+    let measured = cov(&ex, mx, &ez, mz) / (cov(&ex, mx, &ex, mx) * cov(&ez, mz, &ez, mz)).sqrt();
+    println!("x, z error correlation {measured:.4} (inverse projection: {r:.4})");
+    // 25600 samples: the sampling error of a correlation is ~(1 - r^2) / sqrt(n) ~ 0.004
+    assert!((measured - r).abs() < 0.03, "{measured} vs {r}");
+    assert!(r.abs() > 0.5, "{r}");
+    let note = c
+        .report
+        .notes
+        .iter()
+        .find(|n| n.contains("correlated noise"))
+        .unwrap_or_else(|| panic!("{:?}", c.report.notes));
+    assert!(
+        note.contains("40 deg apart") && note.contains(&format!("{r:+.2}")),
+        "{note}"
+    );
+    // at right angles, no such note
+    let acq = Acquisition::example();
+    let raw = simulate_raw(&s, &acq).unwrap();
+    let c = condition(&raw.running, &acq, None, Some(&guess(&s))).unwrap();
+    assert!(
+        !c.report.notes.iter().any(|n| n.contains("correlated")),
+        "{:?}",
+        c.report.notes
+    );
+}
