@@ -44,6 +44,22 @@ const TRUTH: [(&str, f64); 10] = [
     ("unbalance0.alpha", 0.523_598_775_598_298_8),
 ];
 
+/// `rotorid simulate --scenario TOML --raw` into DIR/raw.csv.
+fn raw_record(dir: &std::path::Path, toml: &str) -> std::path::PathBuf {
+    let raw = dir.join("raw.csv");
+    let out = crate::common::rotorid()
+        .args(["simulate", "--scenario", toml, "--raw", "-q", "--out"])
+        .arg(&raw)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    raw
+}
+
 #[test]
 fn a_raw_record_of_a_finite_element_rotor_is_identified_with_its_offsets() {
     let dir = tempfile::tempdir().unwrap();
@@ -65,17 +81,7 @@ fn a_raw_record_of_a_finite_element_rotor_is_identified_with_its_offsets() {
     }
     let guess = dir.path().join("guess.toml");
     std::fs::write(&guess, guess_text).unwrap();
-    let raw = dir.path().join("raw.csv");
-    let out = crate::common::rotorid()
-        .args(["simulate", "--scenario", &toml, "--raw", "-q", "--out"])
-        .arg(&raw)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let raw = raw_record(dir.path(), &toml);
     let (_, s) = identify_outputs(
         dir.path(),
         raw.to_str().unwrap(),
@@ -153,17 +159,7 @@ fn a_raw_record_taken_at_another_speed_than_the_scenario_is_refused_by_name() {
         dir.path(),
         &format!("{PROBES}[acquisition.simulate]\nsnr_db = 60.0\nseed = 5\n"),
     );
-    let raw = dir.path().join("raw.csv");
-    let out = crate::common::rotorid()
-        .args(["simulate", "--scenario", &toml, "--raw", "-q", "--out"])
-        .arg(&raw)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let raw = raw_record(dir.path(), &toml);
     let text = std::fs::read_to_string(&toml).unwrap();
     let other = dir.path().join("other.toml");
     std::fs::write(&other, text.replace("rpm = 3000.0", "rpm = 3030.0")).unwrap();
