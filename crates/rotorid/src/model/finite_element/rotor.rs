@@ -404,7 +404,7 @@ mod tests {
         };
         assert_eq!(
             serde_json::to_string(&u).unwrap(),
-            r#"{"node":1,"mud":1e-5,"alpha":0.5}"#
+            r#"{"node":1,"mud":0.00001,"alpha":0.5}"#
         );
     }
 
