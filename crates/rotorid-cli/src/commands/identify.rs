@@ -43,14 +43,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
             args.time_tolerance
         );
     }
-    let mut outputs = vec![("--out", args.out.as_str())];
-    if let Some(s) = &args.summary {
-        outputs.push(("--summary", s.as_str()));
-    }
-    check_distinct_files(
-        &[("the input", &args.input), ("--scenario", &args.scenario)],
-        &outputs,
-    )?;
+    check_outputs(&args)?;
     let columns = args.columns.as_deref();
     let (name, input) = if let Some(acq) = spec.acquisition() {
         // a raw acquisition: conditioned and identified until the rotor guess settles,
@@ -118,11 +111,7 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
     ident.input = Some(args.input.clone());
     ident.scenario = Some(spec.origin().to_owned());
     if let Some(path) = &args.summary {
-        let mut f = Output::create(path, FileMode::Atomic)?;
-        serde_json::to_writer_pretty(&mut f, &ident)
-            .with_context(|| format!("cannot write {path}"))?;
-        std::io::Write::write_all(&mut f, b"\n").with_context(|| format!("cannot write {path}"))?;
-        f.commit()?;
+        write_summary(path, &ident)?;
     }
     let text = if args.quiet {
         report::warning_lines(&ident).join("\n")
@@ -133,4 +122,27 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         eprintln!("{text}");
     }
     Ok(())
+}
+
+/// Refuse an output (`--out`, `--summary`) that is the input, the scenario or the other
+/// output: identify's check for every model.
+fn check_outputs(args: &IdentifyArgs) -> anyhow::Result<()> {
+    let mut outputs = vec![("--out", args.out.as_str())];
+    if let Some(s) = &args.summary {
+        outputs.push(("--summary", s.as_str()));
+    }
+    check_distinct_files(
+        &[("the input", &args.input), ("--scenario", &args.scenario)],
+        &outputs,
+    )
+}
+
+/// Write `summary` to `path` as pretty JSON and a newline, atomically (a reader never sees
+/// half of it).
+fn write_summary(path: &str, summary: &impl serde::Serialize) -> anyhow::Result<()> {
+    let mut f = Output::create(path, FileMode::Atomic)?;
+    serde_json::to_writer_pretty(&mut f, summary)
+        .with_context(|| format!("cannot write {path}"))?;
+    std::io::Write::write_all(&mut f, b"\n").with_context(|| format!("cannot write {path}"))?;
+    f.commit()
 }

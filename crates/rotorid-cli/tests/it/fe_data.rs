@@ -172,31 +172,60 @@ fn a_raw_record_conditions_back_to_the_response_at_the_probes_nodes() {
 
 #[test]
 fn noise_and_quantisation_are_what_the_record_carries() {
+    // the 16-bit step over the 24 V of [-24, 0] V, in volts and, at 7874 V/m, in metres
+    let q_v = 24.0 / 65536.0;
+    let q = q_v / 7874.0;
     let dir = tempfile::tempdir().unwrap();
-    let toml = two_node(
-        dir.path(),
-        &format!(
-            "{PROBES}[acquisition.simulate]\nsnr_db = 20.0\nseed = 3\nbits = 16\n\
-             runout_um = [[0.0], [0.0], [0.0], [0.0]]\n"
-        ),
-    );
-    let (cond, truth) = raw_round_trip(dir.path(), &toml);
-    // each probe: white noise sigma = RMS 10^(-20/20) on x, y, and the 16-bit step over
-    // 24 V at 7874 V/m, q = 24 / 2^16 / 7874 m, RMS q / sqrt(12); the pairs are at right
-    // angles, so x, y carry the same
-    let q = 24.0 / 65536.0 / 7874.0;
-    for (j, [_, _, rms, _, trms]) in compare(&cond, &truth).into_iter().enumerate() {
-        let sigma = 0.1 * trms;
-        let expect = (sigma * sigma + q * q / 12.0).sqrt();
-        println!(
-            "column {j}: error RMS {rms:.3e} m, expected {expect:.3e} m (noise {sigma:.2e}, \
-             quantisation {:.2e})",
-            q / 12f64.sqrt()
+    // white noise at 20 dB and the quantisation; then the quantisation alone
+    for snr in [Some(20.0), None] {
+        let toml = two_node(
+            dir.path(),
+            &format!(
+                "{PROBES}[acquisition.simulate]\nsnr_db = {}\nseed = 3\nbits = 16\n\
+                 runout_um = [[0.0], [0.0], [0.0], [0.0]]\n",
+                snr.map_or("inf".to_owned(), |s: f64| s.to_string())
+            ),
         );
-        assert!(
-            (rms / expect - 1.0).abs() < 0.08,
-            "{j}: {rms:e} vs {expect:e}"
-        );
+        let (cond, truth) = raw_round_trip(dir.path(), &toml);
+        // the record's volts are the ADC's: every probe sample on the grid -24 V + k q_v
+        // (the CSV holds the shortest digits that read back, so k is an integer to
+        // rounding), over many steps (a swing of 2 x 0.8 um x 7874 V/m = 13 mV, 34 steps)
+        let (head, rows) = columns(&std::fs::read_to_string(dir.path().join("raw.csv")).unwrap());
+        let mut probes = 0;
+        for (j, name) in head.split(',').enumerate() {
+            if !["b1", "b2", "a0", "a1"].contains(&name) {
+                continue;
+            }
+            probes += 1;
+            let mut levels = std::collections::BTreeSet::new();
+            for r in &rows {
+                let k = (r[j] + 24.0) / q_v;
+                assert!(
+                    (k - k.round()).abs() < 1e-6,
+                    "{name}: {} V is not on the 16-bit grid of [-24, 0] V",
+                    r[j]
+                );
+                levels.insert(k.round() as i64);
+            }
+            assert!(levels.len() >= 20, "{name}: {} levels", levels.len());
+        }
+        assert_eq!(probes, 4, "{head}");
+        // each probe: white noise sigma = RMS 10^(-20/20) on x, y, and the quantisation,
+        // RMS q / sqrt(12); the pairs are at right angles, so x, y carry the same
+        for (j, [_, _, rms, _, trms]) in compare(&cond, &truth).into_iter().enumerate() {
+            let sigma = snr.map_or(0.0, |s| 10f64.powf(-s / 20.0) * trms);
+            let expect = (sigma * sigma + q * q / 12.0).sqrt();
+            println!(
+                "SNR {snr:?} dB, column {j}: error RMS {rms:.3e} m, expected {expect:.3e} m \
+                 (noise {sigma:.2e}, quantisation {:.2e}; response RMS {trms:.2e})",
+                q / 12f64.sqrt()
+            );
+            let tol = if snr.is_some() { 0.08 } else { 0.1 };
+            assert!(
+                (rms / expect - 1.0).abs() < tol,
+                "{j}: {rms:e} vs {expect:e}"
+            );
+        }
     }
 }
 

@@ -10,7 +10,7 @@ use rotorid::refine::finite_element::{refine_fe, FeData, FeInitial, FeRefineOpti
 use rotorid::simulate::finite_element::FeResponse;
 
 use super::{IdentifyArgs, IdentifyMethod};
-use crate::io::{check_distinct_files, FileMode, Output, ScenarioSpec};
+use crate::io::{FileMode, Output, ScenarioSpec};
 
 /// Identify a finite-element rotor (module doc).
 pub fn run(args: &IdentifyArgs, spec: &ScenarioSpec) -> anyhow::Result<()> {
@@ -31,14 +31,7 @@ pub fn run(args: &IdentifyArgs, spec: &ScenarioSpec) -> anyhow::Result<()> {
             bail!("{flag} does not apply to a finite-element rotor (rotor.model = \"finite_element\")");
         }
     }
-    let mut outputs = vec![("--out", args.out.as_str())];
-    if let Some(s) = &args.summary {
-        outputs.push(("--summary", s.as_str()));
-    }
-    check_distinct_files(
-        &[("the input", &args.input), ("--scenario", &args.scenario)],
-        &outputs,
-    )?;
+    super::check_outputs(args)?;
     let start = crate::io::finite_element::finite_element_of(spec)?;
     let mut options = FeRefineOptions::new(&start);
     if let Some(names) = &args.settings.unknowns {
@@ -132,11 +125,7 @@ pub fn run(args: &IdentifyArgs, spec: &ScenarioSpec) -> anyhow::Result<()> {
         .with_context(|| format!("cannot write {}", args.out))?;
     out.commit()?;
     if let Some(path) = &args.summary {
-        let mut f = Output::create(path, FileMode::Atomic)?;
-        serde_json::to_writer_pretty(&mut f, &summary)
-            .with_context(|| format!("cannot write {path}"))?;
-        std::io::Write::write_all(&mut f, b"\n").with_context(|| format!("cannot write {path}"))?;
-        f.commit()?;
+        super::write_summary(path, &summary)?;
     }
     if !args.quiet {
         eprintln!("{}", report(&summary));

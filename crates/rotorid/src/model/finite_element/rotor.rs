@@ -222,8 +222,9 @@ impl FeMatrices {
 }
 
 /// A bearing: its restoring force at its node's (x, y) is `-[[kxx, kxy], [kyx, kyy]] (x,
-/// y) - [[cxx, cxy], [cyx, cyy]] (x', y')`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// y) - [[cxx, cxy], [cyx, cyy]] (x', y')`. Serialized as an object of its fields in
+/// this order (the `rotor.bearings` of a finite-element summary, docs/summary.md).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Bearing {
     /// The node it stands at.
     pub node: u32,
@@ -296,8 +297,9 @@ impl Bearing {
 }
 
 /// An unbalance at a node: `mud` = m_u d \[kg m\] at angle `alpha` \[rad\] from +x
-/// towards +y at phi = 0 (ROSS's unbalance magnitude and phase).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// towards +y at phi = 0 (ROSS's unbalance magnitude and phase). Serialized as an object
+/// of its fields in this order (the `rotor.unbalances` of a finite-element summary).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct FeUnbalance {
     /// The node it stands at.
     pub node: u32,
@@ -374,6 +376,37 @@ impl FiniteElementRotor {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bearings_and_unbalances_serialize_as_the_summary_contract_writes_them() {
+        // the `rotor` of a finite-element SUMMARY.json (docs/summary.md): these types are
+        // written as they are, so a field added to them, renamed or moved would change the
+        // summary's bytes; the text below is the contract's, key for key and in order
+        let b = Bearing {
+            node: 3,
+            kxx: 1.5e6,
+            kxy: 2.0e4,
+            kyx: -2.5e4,
+            kyy: 1.1e6,
+            cxx: 300.0,
+            cxy: -20.0,
+            cyx: 15.0,
+            cyy: 250.0,
+        };
+        assert_eq!(
+            serde_json::to_string(&b).unwrap(),
+            r#"{"node":3,"kxx":1500000.0,"kxy":20000.0,"kyx":-25000.0,"kyy":1100000.0,"cxx":300.0,"cxy":-20.0,"cyx":15.0,"cyy":250.0}"#
+        );
+        let u = FeUnbalance {
+            node: 1,
+            mud: 1e-5,
+            alpha: 0.5,
+        };
+        assert_eq!(
+            serde_json::to_string(&u).unwrap(),
+            r#"{"node":1,"mud":0.00001,"alpha":0.5}"#
+        );
+    }
 
     #[test]
     fn dof_names_round_trip_and_bad_ones_are_refused_by_name() {

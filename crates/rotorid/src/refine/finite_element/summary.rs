@@ -7,6 +7,7 @@
 use serde::Serialize;
 
 use super::{FeInitial, FeOffset, FeReduction, FeRefined, FeWarning};
+use crate::model::finite_element::{Bearing, FeUnbalance};
 use crate::pipeline::{ChannelAdequacy, IDENTIFICATION_SCHEMA};
 
 /// The summary (module doc). Non-finite numbers are written as null.
@@ -118,45 +119,19 @@ pub struct FeParameterSummary {
 /// The rotor's bearings and unbalances.
 #[derive(Debug, Clone, Serialize)]
 pub struct FeRotorSummary {
-    /// Each bearing: node and eight coefficients (N/m, N s/m).
-    pub bearings: Vec<FeBearingSummary>,
-    /// Each unbalance: node, mud \[kg m\], alpha \[rad\].
-    pub unbalances: Vec<FeUnbalanceSummary>,
+    /// Each bearing: `node` and the eight coefficients `kxx`, `kxy`, `kyx`, `kyy` \[N/m\],
+    /// `cxx`, `cxy`, `cyx`, `cyy` \[N s/m\], in that order.
+    pub bearings: Vec<Bearing>,
+    /// Each unbalance: `node`, `mud` \[kg m\], `alpha` \[rad\] (from +x towards +y at
+    /// phi = 0).
+    pub unbalances: Vec<FeUnbalance>,
 }
 
-/// A bearing.
-#[derive(Debug, Clone, Serialize)]
-pub struct FeBearingSummary {
-    /// Its node.
-    pub node: u32,
-    /// \[N/m\].
-    pub kxx: f64,
-    /// \[N/m\].
-    pub kxy: f64,
-    /// \[N/m\].
-    pub kyx: f64,
-    /// \[N/m\].
-    pub kyy: f64,
-    /// \[N s/m\].
-    pub cxx: f64,
-    /// \[N s/m\].
-    pub cxy: f64,
-    /// \[N s/m\].
-    pub cyx: f64,
-    /// \[N s/m\].
-    pub cyy: f64,
-}
+/// A bearing of the summary: the model's [`Bearing`], written field for field.
+pub type FeBearingSummary = Bearing;
 
-/// An unbalance.
-#[derive(Debug, Clone, Serialize)]
-pub struct FeUnbalanceSummary {
-    /// Its node.
-    pub node: u32,
-    /// m_u d \[kg m\].
-    pub mud: f64,
-    /// Angle at phi = 0 from +x towards +y \[rad\].
-    pub alpha: f64,
-}
+/// An unbalance of the summary: the model's [`FeUnbalance`], written field for field.
+pub type FeUnbalanceSummary = FeUnbalance;
 
 /// Covariance with names.
 #[derive(Debug, Clone, Serialize)]
@@ -252,30 +227,8 @@ impl FeSummary {
             offsets: fit.offsets.clone(),
             parameters,
             rotor: FeRotorSummary {
-                bearings: r
-                    .bearings
-                    .iter()
-                    .map(|b| FeBearingSummary {
-                        node: b.node,
-                        kxx: b.kxx,
-                        kxy: b.kxy,
-                        kyx: b.kyx,
-                        kyy: b.kyy,
-                        cxx: b.cxx,
-                        cxy: b.cxy,
-                        cyx: b.cyx,
-                        cyy: b.cyy,
-                    })
-                    .collect(),
-                unbalances: r
-                    .unbalances
-                    .iter()
-                    .map(|u| FeUnbalanceSummary {
-                        node: u.node,
-                        mud: u.mud,
-                        alpha: u.alpha,
-                    })
-                    .collect(),
+                bearings: r.bearings.clone(),
+                unbalances: r.unbalances.clone(),
             },
             covariance: FeCovariance {
                 names: fit.parameters.iter().map(|p| p.parameter.clone()).collect(),
