@@ -61,8 +61,8 @@ use crate::simulate::SimulateError;
 pub use evaluate::FeProblem;
 pub use result::{FeFittedValue, FeOffset, FeReduction, FeRefined, FeWarning};
 pub use summary::{
-    FeAdequacy, FeBearingSummary, FeCovariance, FeInitialStateSummary, FeNoise, FeParameterSummary,
-    FeRecordSummary, FeRotorSummary, FeSummary, FeUnbalanceSummary,
+    FeAdequacy, FeCovariance, FeInitialStateSummary, FeNoise, FeParameterSummary, FeRecordSummary,
+    FeRotorSummary, FeSummary,
 };
 
 /// The initial state of a finite-element fit.

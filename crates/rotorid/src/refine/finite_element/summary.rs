@@ -127,12 +127,6 @@ pub struct FeRotorSummary {
     pub unbalances: Vec<FeUnbalance>,
 }
 
-/// A bearing of the summary: the model's [`Bearing`], written field for field.
-pub type FeBearingSummary = Bearing;
-
-/// An unbalance of the summary: the model's [`FeUnbalance`], written field for field.
-pub type FeUnbalanceSummary = FeUnbalance;
-
 /// Covariance with names.
 #[derive(Debug, Clone, Serialize)]
 pub struct FeCovariance {
