@@ -157,9 +157,11 @@ pub struct AnalyzeArgs {
     #[arg(long, value_name = "RPM", value_parser = parse_operating_rpm)]
     pub operating_rpm: Option<f64>,
 
-    /// Amplitude unit of the figures: um or mil peak-to-peak (analysis.json is in um).
-    #[arg(long, value_enum, default_value_t = AmplitudeUnit::Um)]
-    pub unit: AmplitudeUnit,
+    /// Amplitude unit of the figures: um or mil peak-to-peak (analysis.json is in um);
+    /// default um. Refused for a finite-element rotor, whose analysis has no amplitude
+    /// figure yet.
+    #[arg(long, value_enum, value_name = "UNIT")]
+    pub unit: Option<AmplitudeUnit>,
 }
 
 /// `--unit` values.
@@ -177,6 +179,14 @@ impl AmplitudeUnit {
         match self {
             AmplitudeUnit::Um => 2.0e6,
             AmplitudeUnit::Mil => 2.0 / 25.4e-6,
+        }
+    }
+
+    /// As written on the command line.
+    fn name(self) -> &'static str {
+        match self {
+            AmplitudeUnit::Um => "um",
+            AmplitudeUnit::Mil => "mil",
         }
     }
 
@@ -210,6 +220,14 @@ impl RpmGrid {
             }
         }
         v
+    }
+
+    /// The same speeds \[rad/s\].
+    pub fn speeds_rad_per_s(&self) -> Vec<f64> {
+        self.speeds_rpm()
+            .into_iter()
+            .map(rpm_to_rad_per_s)
+            .collect()
     }
 }
 
@@ -592,12 +610,7 @@ fn compute(
     rotor: IdentifiedRotor,
     scenario_speed: Option<f64>,
 ) -> anyhow::Result<Results> {
-    let speeds: Vec<f64> = args
-        .rpm
-        .speeds_rpm()
-        .into_iter()
-        .map(rpm_to_rad_per_s)
-        .collect();
+    let speeds = args.rpm.speeds_rad_per_s();
     let p = rotor.params;
     let cov = rotor.covariance.as_ref();
     let camp = campbell(&p, &speeds)?;
@@ -641,16 +654,17 @@ fn with_std_fixed(v: f64, std: Option<f64>, digits: usize) -> String {
     }
 }
 
-/// The instability in words: where it starts (with its standard deviation), the mode and
-/// whirl that grow, where the rotor is stable again, and what causes it.
-fn instability_text(st: &Stability, cross: bool) -> String {
+/// The instability in words: where it starts (with its standard deviation), the mode
+/// (`mode_name` of its index: "lower", "mode 3") and whirl that grow, where the rotor is
+/// stable again, and what causes it.
+fn instability_text(st: &Stability, mode_name: &dyn Fn(usize) -> String, cross: bool) -> String {
     let Some(t) = st.threshold else {
         return "stable over the range".to_string();
     };
     let whirl = st
         .threshold_whirl
         .map_or("a".to_string(), |w| format!("the {}", w.name()));
-    let mode = ["lower", "higher"][st.threshold_mode.unwrap_or(0).min(1)];
+    let mode = mode_name(st.threshold_mode.unwrap_or(0));
     let mut s = if st.unstable_at_start {
         format!(
             "UNSTABLE from the start of the range ({:.1} rpm): {whirl} whirl ({mode}) mode's log decrement is negative",
@@ -715,12 +729,7 @@ pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
         .collect();
     let figures = write_figures(&args, &r, &source, &marks)?;
     let json = analysis_json(&args, &r, &source, &figures);
-    let path = args.out.join("analysis.json");
-    let mut out = Output::create(&path.display().to_string(), FileMode::Atomic)?;
-    serde_json::to_writer_pretty(&mut out, &json)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    std::io::Write::write_all(&mut out, b"\n")?;
-    out.commit()?;
+    write_analysis_json(&args.out, &json)?;
     let html = render_report(&json, &args.out, &report_figures())?;
     let report = args.out.join("report.html");
     std::fs::write(&report, html).with_context(|| format!("cannot write {}", report.display()))?;
@@ -732,64 +741,105 @@ pub fn run(args: AnalyzeArgs) -> anyhow::Result<()> {
         "no covariance: no standard deviations"
     };
     outln!("rotor from {source} ({uncertainty})")?;
-    let g = args.rpm;
-    outln!("critical speeds ({}-{} rpm):", g.start, g.stop)?;
-    if r.critical.is_empty() {
-        outln!("  none")?;
-    }
-    for (n, c) in r.critical.iter().enumerate() {
-        outln!(
-            "  {}: {}  {}  (log dec {})",
-            n + 1,
-            with_std(c.rpm(), c.std_rpm(), "rpm"),
-            whirl_name(c.whirl()),
-            c.at.log_dec
-                .map_or("-".into(), |d| with_std_fixed(d, c.log_dec_std, 4))
-        )?;
-    }
-    let st = &r.stability;
-    match (st.threshold, st.min_log_dec) {
-        (None, Some(d)) => outln!(
-            "stability: stable over the range; minimum log decrement {d:.4} ({} mode at {:.0} rpm)",
-            ["lower", "higher"][st.min_log_dec_mode.unwrap_or(0).min(1)],
-            rad_per_s_to_rpm(st.min_log_dec_speed.unwrap_or(0.0))
-        )?,
-        (None, None) => outln!("stability: stable over the range")?,
-        (Some(_), _) => {
-            let text = instability_text(st, r.params.coupling.is_some());
-            outln!("stability: {text}")?;
-            eprintln!("warning: {text}");
-        }
-    }
+    print_critical_speeds(args.rpm, &r.critical, |_| String::new())?;
+    let two = |m: usize| ["lower", "higher"][m.min(1)].to_owned();
+    print_stability(
+        &r.stability,
+        &|m| format!("{} mode", two(m)),
+        &instability_text(&r.stability, &two, r.params.coupling.is_some()),
+    )?;
     if let Some((m, src)) = &r.operating {
-        let rpm = rad_per_s_to_rpm(m.speed);
-        let from = if *src == "given" {
-            "--operating-rpm"
-        } else {
-            "the scenario's speed"
-        };
-        let d = m
-            .log_dec()
-            .map_or("- (the mode does not oscillate)".into(), |d| {
-                with_std_fixed(d, m.log_dec_std, 4)
-            });
-        outln!(
-            "stability margin at {rpm:.1} rpm ({from}): log decrement {d} of the least damped mode ({} mode, {})",
-            ["lower", "higher"][m.mode.min(1)],
-            whirl_name(m.at.whirl)
-        )?;
-        if m.is_unstable() {
-            eprintln!(
-                "warning: the rotor is UNSTABLE at the operating speed {rpm:.1} rpm: the {} mode's log decrement is {d}",
-                whirl_name(m.at.whirl)
-            );
-        }
+        let which = format!("{} mode, {}", two(m.mode), whirl_name(m.at.whirl));
+        print_margin(m, src, &which)?;
     }
     outln!(
         "wrote {}: analysis.json, {}, report.html",
         args.out.display(),
         figures.join(", ")
     )?;
+    Ok(())
+}
+
+/// `json` as `dir/analysis.json` (pretty, written atomically).
+fn write_analysis_json(dir: &Path, json: &impl Serialize) -> anyhow::Result<()> {
+    let path = dir.join("analysis.json");
+    let mut out = Output::create(&path.display().to_string(), FileMode::Atomic)?;
+    serde_json::to_writer_pretty(&mut out, json)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    std::io::Write::write_all(&mut out, b"\n")?;
+    out.commit()?;
+    Ok(())
+}
+
+/// The critical speeds over the grid `g` on stdout, `extra` after each one's whirl.
+fn print_critical_speeds(
+    g: RpmGrid,
+    critical: &[CriticalSpeed],
+    extra: impl Fn(&CriticalSpeed) -> String,
+) -> anyhow::Result<()> {
+    outln!("critical speeds ({}-{} rpm):", g.start, g.stop)?;
+    if critical.is_empty() {
+        outln!("  none")?;
+    }
+    for (n, c) in critical.iter().enumerate() {
+        outln!(
+            "  {}: {}  {}{}  (log dec {})",
+            n + 1,
+            with_std(c.rpm(), c.std_rpm(), "rpm"),
+            whirl_name(c.whirl()),
+            extra(c),
+            c.at.log_dec
+                .map_or("-".into(), |d| with_std_fixed(d, c.log_dec_std, 4))
+        )?;
+    }
+    Ok(())
+}
+
+/// Stability over the range on stdout (`mode_name` names a mode by its index; `unstable`
+/// is [`instability_text`]), and on stderr as a warning when unstable.
+fn print_stability(
+    st: &Stability,
+    mode_name: &dyn Fn(usize) -> String,
+    unstable: &str,
+) -> anyhow::Result<()> {
+    match (st.threshold, st.min_log_dec) {
+        (None, Some(d)) => outln!(
+            "stability: stable over the range; minimum log decrement {d:.4} ({} at {:.0} rpm)",
+            mode_name(st.min_log_dec_mode.unwrap_or(0)),
+            rad_per_s_to_rpm(st.min_log_dec_speed.unwrap_or(0.0))
+        )?,
+        (None, None) => outln!("stability: stable over the range")?,
+        (Some(_), _) => {
+            outln!("stability: {unstable}")?;
+            eprintln!("warning: {unstable}");
+        }
+    }
+    Ok(())
+}
+
+/// The stability margin at the operating speed on stdout (`which` names the least damped
+/// mode and its whirl), with a warning on stderr when that mode grows.
+fn print_margin(m: &StabilityMargin, src: &str, which: &str) -> anyhow::Result<()> {
+    let rpm = rad_per_s_to_rpm(m.speed);
+    let from = if src == "given" {
+        "--operating-rpm"
+    } else {
+        "the scenario's speed"
+    };
+    let d = m
+        .log_dec()
+        .map_or("- (the mode does not oscillate)".into(), |d| {
+            with_std_fixed(d, m.log_dec_std, 4)
+        });
+    outln!(
+        "stability margin at {rpm:.1} rpm ({from}): log decrement {d} of the least damped mode ({which})"
+    )?;
+    if m.is_unstable() {
+        eprintln!(
+            "warning: the rotor is UNSTABLE at the operating speed {rpm:.1} rpm: the {} mode's log decrement is {d}",
+            whirl_name(m.at.whirl)
+        );
+    }
     Ok(())
 }
 
@@ -880,7 +930,7 @@ fn write_figures(
             .collect(),
         critical: marks.to_vec(),
     };
-    let per_m = args.unit.per_metre_peak();
+    let per_m = args.unit.unwrap_or(AmplitudeUnit::Um).per_metre_peak();
     let rpm: Vec<f64> = r
         .response
         .speeds
@@ -907,7 +957,7 @@ fn write_figures(
             std_phase_lag_deg: s.std_lag_deg,
         });
     }
-    let unit = args.unit.label().to_string();
+    let unit = args.unit.unwrap_or(AmplitudeUnit::Um).label().to_string();
     let bode = BodePlot {
         title: format!("Unbalance response (Bode) \u{2014} {source}"),
         rpm: rpm.clone(),

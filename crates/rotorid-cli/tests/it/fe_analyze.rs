@@ -127,4 +127,22 @@ fn finite_element_inputs_are_checked_by_name() {
     );
     let e = analyze(&["--scenario", &fe, "--probe", "45"]).unwrap_err();
     assert!(e.contains("--probe"), "{e}");
+    // --unit converts amplitudes the finite-element analysis does not draw: refused by
+    // name, whichever unit, rather than ignored
+    for unit in ["mil", "um"] {
+        let e = analyze(&[&s, "--scenario", &fe, "--unit", unit]).unwrap_err();
+        assert!(
+            e.contains(&format!("--unit {unit}")) && e.contains("no amplitude figure"),
+            "{e}"
+        );
+    }
+    // the 2-DOF analysis takes it
+    let two_mil = analyze(&[
+        two.to_str().unwrap(),
+        "--unit",
+        "mil",
+        "--rpm",
+        "0:3000:100",
+    ]);
+    assert!(two_mil.is_ok(), "{two_mil:?}");
 }

@@ -22,7 +22,8 @@
 //! ```
 //!
 //! with u and r the right and left null vectors of Q(lambda) (Q u ~ 0, r Q ~ 0, no
-//! conjugation), each one step of inverse iteration (complex LU with partial pivoting). A
+//! conjugation), each one step of inverse iteration, both from one complex LU with
+//! partial pivoting of Q(lambda) (the `complex_lu` module; r from its transposed solve). A
 //! mode is an eigenvalue with Im lambda > 0 (overdamped, real eigenvalues have no damped
 //! natural frequency and are left out); per mode, as for the 2-DOF models: damped natural
 //! frequency w_d = Im lambda, damping ratio -Re lambda / |lambda|, logarithmic decrement
@@ -85,10 +86,11 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
+use super::complex_lu::ComplexLu;
 use super::covariance::validate_matrix;
 use super::critical::CriticalSpeed;
 use super::error::{check_speed, check_speeds, AnalysisError};
-use super::modes::{Mode, Whirl, C64, PLANAR_WHIRL};
+use super::modes::{majority_whirl, Mode, Whirl, C64};
 use super::stability::{Stability, StabilityMargin, UNSTABLE_ZETA};
 use crate::model::check;
 use crate::model::finite_element::{
@@ -237,6 +239,23 @@ fn dot(a: &DVector<C64>, b: &DVector<C64>) -> C64 {
     a.iter().zip(b.iter()).map(|(x, y)| x * y).sum()
 }
 
+/// r^T A u (no conjugation) for a real square matrix A: sum over the columns j of
+/// (column j . r) u_j, down contiguous columns.
+fn bilinear(a: &DMatrix<f64>, r: &DVector<C64>, u: &DVector<C64>) -> C64 {
+    let n = a.nrows();
+    let r = r.as_slice();
+    let mut s = Complex::new(0.0, 0.0);
+    for (col, &uj) in a.as_slice().chunks_exact(n).zip(u.iter()) {
+        let (mut re, mut im) = (0.0, 0.0);
+        for (&aij, ri) in col.iter().zip(r) {
+            re += aij * ri.re;
+            im += aij * ri.im;
+        }
+        s += Complex::new(re, im) * uj;
+    }
+    s
+}
+
 fn complex(a: &DMatrix<f64>) -> DMatrix<C64> {
     a.map(|v| Complex::new(v, 0.0))
 }
@@ -306,24 +325,20 @@ impl Solver {
         ev
     }
 
-    fn q(&self, c: &DMatrix<f64>, l: C64) -> DMatrix<C64> {
+    /// The right and left null vectors of Q(l) = l^2 M + l C + K0 by one step of inverse
+    /// iteration each, both from one LU factorization of Q(l) (in `lu`); `None` when Q(l)
+    /// is exactly singular in floating point.
+    fn null_vectors(
+        &self,
+        lu: &mut ComplexLu,
+        c: &DMatrix<f64>,
+        l: C64,
+    ) -> Option<(DVector<C64>, DVector<C64>)> {
         let (m, k) = (self.sys.mass(), self.sys.stiffness0());
         let l2 = l * l;
-        DMatrix::from_fn(self.n(), self.n(), |i, j| {
-            l2 * m[(i, j)] + l * c[(i, j)] + k[(i, j)]
-        })
-    }
-
-    fn dq(&self, c: &DMatrix<f64>, l: C64) -> DMatrix<C64> {
-        let m = self.sys.mass();
-        DMatrix::from_fn(self.n(), self.n(), |i, j| l * (2.0 * m[(i, j)]) + c[(i, j)])
-    }
-
-    /// The right and left null vectors of Q(l) by one step of inverse iteration each;
-    /// `None` when Q(l) is exactly singular in floating point.
-    fn null_vectors(&self, q: &DMatrix<C64>) -> Option<(DVector<C64>, DVector<C64>)> {
-        let u = q.clone().lu().solve(&self.b)?;
-        let r = q.transpose().lu().solve(&self.b)?;
+        lu.factor(|i, j| l2 * m[(i, j)] + l * c[(i, j)] + k[(i, j)]);
+        let u = lu.solve(&self.b)?;
+        let r = lu.solve_transposed(&self.b)?;
         let (nu, nr) = (u.norm(), r.norm());
         if !(nu.is_finite() && nr.is_finite() && nu > 0.0 && nr > 0.0) {
             return None;
@@ -334,20 +349,24 @@ impl Solver {
     /// The eigenvalue near `l0` at speed `w`, polished (module doc).
     fn refine(&self, w: f64, l0: C64) -> Option<Eig> {
         let c = self.sys.damping(w);
+        let mut lu = ComplexLu::new(self.n());
         let mut l = l0;
         let mut last = None;
         for _ in 0..8 {
-            let q = self.q(&c, l);
-            let (u, r) = match self.null_vectors(&q) {
+            let (u, r) = match self.null_vectors(&mut lu, &c, l) {
                 Some(v) => v,
                 // exactly singular: l is an eigenvalue to rounding; move off it
                 None => {
                     let lp = l * (1.0 + 4.0 * f64::EPSILON);
-                    self.null_vectors(&self.q(&c, lp))?
+                    self.null_vectors(&mut lu, &c, lp)?
                 }
             };
-            let den = dot(&r, &(self.dq(&c, l) * &u));
-            let num = dot(&r, &(&q * &u));
+            // r^T Q(l) u and r^T Q'(l) u from r^T M u, r^T C u, r^T K0 u
+            let rmu = bilinear(self.sys.mass(), &r, &u);
+            let rcu = bilinear(&c, &r, &u);
+            let rku = bilinear(self.sys.stiffness0(), &r, &u);
+            let den = l * 2.0 * rmu + rcu;
+            let num = l * l * rmu + l * rcu + rku;
             if den.norm() == 0.0 || !den.norm().is_finite() {
                 return None;
             }
@@ -416,8 +435,6 @@ impl Solver {
 
     /// The mode of `e` (module doc).
     fn mode(&self, e: &Eig) -> Mode {
-        let l = e.l;
-        let n = l.norm();
         let whirl_ratio = if e.simple {
             self.nodes
                 .iter()
@@ -430,33 +447,14 @@ impl Solver {
         } else {
             None
         };
-        let whirl = whirl_ratio.and_then(|k| {
-            if k > PLANAR_WHIRL {
-                Some(Whirl::Forward)
-            } else if k < -PLANAR_WHIRL {
-                Some(Whirl::Backward)
-            } else {
-                None
-            }
-        });
-        Mode {
-            eigenvalue: l,
-            frequency: l.im,
-            natural_frequency: n,
-            damping_ratio: if n > 0.0 { -l.re / n } else { 0.0 },
-            log_dec: (l.im > 0.0).then(|| -std::f64::consts::TAU * l.re / l.im),
-            whirl_ratio,
-            whirl,
-        }
+        Mode::of(e.l, whirl_ratio)
     }
 
-    /// |u^H M v|^2 / (u^H M u v^H M v).
-    fn mac(&self, u: &DVector<C64>, v: &DVector<C64>) -> f64 {
-        let mv = &self.m_c * v;
-        let mu = &self.m_c * u;
-        let uv = u.dotc(&mv).norm_sqr();
-        let uu = u.dotc(&mu).norm();
-        let vv = v.dotc(&mv).norm();
+    /// |u^H M v|^2 / (u^H M u v^H M v), with `mu` = M u and `mv` = M v.
+    fn mac(u: &DVector<C64>, mu: &DVector<C64>, v: &DVector<C64>, mv: &DVector<C64>) -> f64 {
+        let uv = u.dotc(mv).norm_sqr();
+        let uu = u.dotc(mu).norm();
+        let vv = v.dotc(mv).norm();
         if uu > 0.0 && vv > 0.0 {
             uv / (uu * vv)
         } else {
@@ -496,11 +494,15 @@ impl Solver {
                     }
                 })
                 .collect();
+            // M u of each mode and candidate, once
+            let m_prev: Vec<DVector<C64>> = prev.iter().map(|e| &self.m_c * &e.u).collect();
+            let m_cands: Vec<DVector<C64>> = cands.iter().map(|e| &self.m_c * &e.u).collect();
             let mut costs = Vec::with_capacity(modes * cands.len());
             for (j, e) in prev.iter().enumerate() {
                 for (c, cand) in cands.iter().enumerate() {
                     let dist = (cand.l - pred[j]).norm() / pred[j].norm().max(f64::MIN_POSITIVE);
-                    costs.push((dist + (1.0 - self.mac(&e.u, &cand.u)), j, c));
+                    let mac = Self::mac(&e.u, &m_prev[j], &cand.u, &m_cands[c]);
+                    costs.push((dist + (1.0 - mac), j, c));
                 }
             }
             costs.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -597,19 +599,7 @@ impl FeCampbell {
     /// The whirl of mode `j` over the grid: the direction most of its speeds show; `None`
     /// when none shows one or both are equally frequent.
     pub fn whirl(&self, j: usize) -> Option<Whirl> {
-        let (mut f, mut b) = (0usize, 0usize);
-        for m in self.mode(j) {
-            match m.whirl {
-                Some(Whirl::Forward) => f += 1,
-                Some(Whirl::Backward) => b += 1,
-                None => {}
-            }
-        }
-        match f.cmp(&b) {
-            std::cmp::Ordering::Greater => Some(Whirl::Forward),
-            std::cmp::Ordering::Less => Some(Whirl::Backward),
-            std::cmp::Ordering::Equal => None,
-        }
+        majority_whirl(self.mode(j))
     }
 }
 
@@ -686,7 +676,7 @@ pub fn fe_analysis(
         }
     }
     critical.sort_by(|a, b| a.speed.total_cmp(&b.speed));
-    let stability = stability(&solver, speeds, &tracked, &params, cov);
+    let stability = stability(&solver, speeds, &tracked, &campbell.modes, &params, cov);
     Ok(FeAnalysis {
         campbell,
         critical,
@@ -755,27 +745,17 @@ fn least_damped(row: &[Eig]) -> (usize, f64) {
         .fold((0, f64::INFINITY), |b, x| if x.1 < b.1 { x } else { b })
 }
 
-/// Stability over the followed modes (module doc; the 2-DOF stability module's rules).
+/// Stability over the followed modes (module doc; the 2-DOF stability module's rules);
+/// `modes` are those of `tracked`.
 fn stability(
     solver: &Solver,
     speeds: &[f64],
     tracked: &[Vec<Eig>],
+    modes: &[Vec<Mode>],
     params: &[FeParameter],
     cov: Option<&FeCovariance>,
 ) -> Stability {
-    let mut out = Stability {
-        min_log_dec: None,
-        min_log_dec_speed: None,
-        min_log_dec_mode: None,
-        min_damping_ratio: f64::INFINITY,
-        threshold: None,
-        threshold_std: None,
-        threshold_mode: None,
-        threshold_whirl: None,
-        unstable_at_start: false,
-        stable_from: None,
-        stable_from_std: None,
-    };
+    let mut out = Stability::unscanned();
     // the crossing of mode j's damping ratio (+ shift) between grid speeds k - 1 and k
     let crossing = |j: usize, k: usize, shift: f64| {
         solver.root(
@@ -789,17 +769,7 @@ fn stability(
     let mut last_unstable: Option<usize> = None;
     for (k, row) in tracked.iter().enumerate() {
         let w = speeds[k];
-        for (j, e) in row.iter().enumerate() {
-            let m = solver.mode(e);
-            out.min_damping_ratio = out.min_damping_ratio.min(m.damping_ratio);
-            if let Some(d) = m.log_dec {
-                if out.min_log_dec.is_none_or(|v| d < v) {
-                    out.min_log_dec = Some(d);
-                    out.min_log_dec_speed = Some(w);
-                    out.min_log_dec_mode = Some(j);
-                }
-            }
-        }
+        out.note_modes(w, modes[k].iter());
         let (jl, z) = least_damped(row);
         let unstable = z < -UNSTABLE_ZETA;
         if out.threshold.is_none() && unstable {

@@ -56,6 +56,7 @@
 //! ```
 
 pub mod balance;
+mod complex_lu;
 mod covariance;
 mod critical;
 mod error;

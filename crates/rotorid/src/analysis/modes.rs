@@ -114,6 +114,32 @@ pub struct Mode {
 }
 
 impl Mode {
+    /// The mode of the eigenvalue `l` (Im l >= 0) whose orbit has the whirl ratio
+    /// `whirl_ratio` (`None`: undefined mode shape): damped natural frequency Im l,
+    /// damping ratio -Re l / |l|, logarithmic decrement -2 pi Re l / Im l, the whirl from
+    /// the ratio's sign (module doc). Shared by the 2-DOF and finite-element analyses.
+    pub(crate) fn of(l: C64, whirl_ratio: Option<f64>) -> Self {
+        let n = l.norm();
+        let whirl = whirl_ratio.and_then(|k| {
+            if k > PLANAR_WHIRL {
+                Some(Whirl::Forward)
+            } else if k < -PLANAR_WHIRL {
+                Some(Whirl::Backward)
+            } else {
+                None
+            }
+        });
+        Mode {
+            eigenvalue: l,
+            frequency: l.im,
+            natural_frequency: n,
+            damping_ratio: if n > 0.0 { -l.re / n } else { 0.0 },
+            log_dec: (l.im > 0.0).then(|| -std::f64::consts::TAU * l.re / l.im),
+            whirl_ratio,
+            whirl,
+        }
+    }
+
     /// Damped natural frequency \[Hz\].
     pub fn frequency_hz(&self) -> f64 {
         self.frequency / std::f64::consts::TAU
@@ -265,29 +291,11 @@ impl Quadratic {
     /// The mode of root `l` (module doc).
     fn mode(&self, l: C64) -> Mode {
         let l = if l.im < 0.0 { l.conj() } else { l };
-        let n = l.norm();
         let whirl_ratio = self.null_vectors(l).map(|(u, _)| {
             let (x, z) = (u[0], u[1]);
             -2.0 * (x * z.conj()).im / (x.norm_sqr() + z.norm_sqr())
         });
-        let whirl = whirl_ratio.and_then(|k| {
-            if k > PLANAR_WHIRL {
-                Some(Whirl::Forward)
-            } else if k < -PLANAR_WHIRL {
-                Some(Whirl::Backward)
-            } else {
-                None
-            }
-        });
-        Mode {
-            eigenvalue: l,
-            frequency: l.im,
-            natural_frequency: n,
-            damping_ratio: if n > 0.0 { -l.re / n } else { 0.0 },
-            log_dec: (l.im > 0.0).then(|| -std::f64::consts::TAU * l.re / l.im),
-            whirl_ratio,
-            whirl,
-        }
+        Mode::of(l, whirl_ratio)
     }
 
     /// The two modes, lower damped natural frequency first: of the four roots, the two
@@ -331,19 +339,25 @@ impl Campbell {
     /// The whirl of mode `i` over the grid: the direction most of its speeds show; `None`
     /// when none shows a direction or both are equally frequent.
     pub fn whirl(&self, i: usize) -> Option<Whirl> {
-        let (mut f, mut b) = (0usize, 0usize);
-        for m in self.mode(i) {
-            match m.whirl {
-                Some(Whirl::Forward) => f += 1,
-                Some(Whirl::Backward) => b += 1,
-                None => {}
-            }
+        majority_whirl(self.mode(i))
+    }
+}
+
+/// The whirl most of `modes` show; `None` when none shows one or both are equally
+/// frequent (the whirl of a followed mode over a Campbell diagram).
+pub(crate) fn majority_whirl<'a>(modes: impl Iterator<Item = &'a Mode>) -> Option<Whirl> {
+    let (mut f, mut b) = (0usize, 0usize);
+    for m in modes {
+        match m.whirl {
+            Some(Whirl::Forward) => f += 1,
+            Some(Whirl::Backward) => b += 1,
+            None => {}
         }
-        match f.cmp(&b) {
-            std::cmp::Ordering::Greater => Some(Whirl::Forward),
-            std::cmp::Ordering::Less => Some(Whirl::Backward),
-            std::cmp::Ordering::Equal => None,
-        }
+    }
+    match f.cmp(&b) {
+        std::cmp::Ordering::Greater => Some(Whirl::Forward),
+        std::cmp::Ordering::Less => Some(Whirl::Backward),
+        std::cmp::Ordering::Equal => None,
     }
 }
 

@@ -104,6 +104,38 @@ pub struct Stability {
 }
 
 impl Stability {
+    /// Nothing seen yet: no mode, no threshold (the start of a scan over a grid).
+    pub(crate) fn unscanned() -> Self {
+        Stability {
+            min_log_dec: None,
+            min_log_dec_speed: None,
+            min_log_dec_mode: None,
+            min_damping_ratio: f64::INFINITY,
+            threshold: None,
+            threshold_std: None,
+            threshold_mode: None,
+            threshold_whirl: None,
+            unstable_at_start: false,
+            stable_from: None,
+            stable_from_std: None,
+        }
+    }
+
+    /// Takes the modes at the grid speed `w` \[rad/s\] into the smallest damping ratio
+    /// and logarithmic decrement (the first of equal minima kept).
+    pub(crate) fn note_modes<'a>(&mut self, w: f64, modes: impl Iterator<Item = &'a Mode>) {
+        for (i, m) in modes.enumerate() {
+            self.min_damping_ratio = self.min_damping_ratio.min(m.damping_ratio);
+            if let Some(d) = m.log_dec {
+                if self.min_log_dec.is_none_or(|v| d < v) {
+                    self.min_log_dec = Some(d);
+                    self.min_log_dec_speed = Some(w);
+                    self.min_log_dec_mode = Some(i);
+                }
+            }
+        }
+    }
+
     /// True when no mode grows anywhere in the range.
     pub fn is_stable(&self) -> bool {
         self.threshold.is_none()
@@ -210,33 +242,12 @@ pub fn stability_with_covariance(
     check_params(p)?;
     check_speeds(speeds, 1)?;
     let zeta = |w: f64| least_damped(p, w).1.damping_ratio;
-    let mut out = Stability {
-        min_log_dec: None,
-        min_log_dec_speed: None,
-        min_log_dec_mode: None,
-        min_damping_ratio: f64::INFINITY,
-        threshold: None,
-        threshold_std: None,
-        threshold_mode: None,
-        threshold_whirl: None,
-        unstable_at_start: false,
-        stable_from: None,
-        stable_from_std: None,
-    };
+    let mut out = Stability::unscanned();
     let mut last_stable: Option<(f64, f64)> = None;
     let mut last_unstable: Option<f64> = None;
     for &w in speeds {
         let modes = Quadratic::new(p, w).modes();
-        for (i, m) in modes.iter().enumerate() {
-            out.min_damping_ratio = out.min_damping_ratio.min(m.damping_ratio);
-            if let Some(d) = m.log_dec {
-                if out.min_log_dec.is_none_or(|v| d < v) {
-                    out.min_log_dec = Some(d);
-                    out.min_log_dec_speed = Some(w);
-                    out.min_log_dec_mode = Some(i);
-                }
-            }
-        }
+        out.note_modes(w, modes.iter());
         let z = modes[0].damping_ratio.min(modes[1].damping_ratio);
         let unstable = z < -UNSTABLE_ZETA;
         if out.threshold.is_none() && unstable {

@@ -33,7 +33,8 @@
 //! (forward: from +x towards +y, the shaft's rotation). Angles are from +x towards +y at
 //! phi = 0, in [0, 360); the correction (a mass at the same m_u d) goes 180 deg opposite.
 //! No unbalance response, Bode or polar plot, and no report.html yet for a finite-element
-//! rotor.
+//! rotor: `--probe` and `--unit` (the amplitude unit of those figures) are refused by name
+//! rather than ignored.
 
 use anyhow::{bail, Context as _};
 use rotorid::analysis::{
@@ -45,12 +46,13 @@ use rotorid::SpeedProfile;
 use serde::Serialize;
 
 use super::{
-    critical_json, instability_text, mode_json, stability_json, whirl_name, with_std_fixed,
-    AnalyzeArgs, CampbellJson, CriticalJson, RpmGrid, StabilityJson, ANALYSIS_FORMAT_VERSION,
+    critical_json, instability_text, mode_json, print_critical_speeds, print_margin,
+    print_stability, stability_json, whirl_name, write_analysis_json, AnalyzeArgs, CampbellJson,
+    CriticalJson, RpmGrid, StabilityJson, ANALYSIS_FORMAT_VERSION,
 };
 use crate::io::fe_summary::{is_finite_element_summary, IdentifiedFe};
 use crate::io::finite_element::finite_element_of;
-use crate::io::{FileMode, LoadScenario as _, Output, ScenarioSpec, SimulationOverrides};
+use crate::io::{LoadScenario as _, ScenarioSpec, SimulationOverrides};
 use crate::plot::campbell::{with_std, CampbellMode, CampbellPlot, CriticalMark};
 use crate::plot::canvas::save_drawing;
 use crate::plot::DEFAULT_SIZE;
@@ -98,6 +100,14 @@ pub(super) fn input(args: &AnalyzeArgs) -> anyhow::Result<Option<FeInput>> {
         }
         (None, None) => return Ok(None),
     };
+    if let Some(unit) = args.unit {
+        bail!(
+            "--unit {}: the analysis of a finite-element rotor has no amplitude figure or \
+             amplitude to convert (Campbell diagram, critical speeds, stability and unbalances \
+             only; see rotorid predict for responses): drop --unit",
+            unit.name()
+        );
+    }
     if !args.probes.is_empty() {
         bail!(
             "--probe: the unbalance response of a finite-element rotor is not computed by \
@@ -243,12 +253,7 @@ pub(super) fn run(args: &AnalyzeArgs, fe: FeInput) -> anyhow::Result<()> {
         Some(m) => m,
         None => DEFAULT_MODES.min(n),
     };
-    let speeds: Vec<f64> = args
-        .rpm
-        .speeds_rpm()
-        .into_iter()
-        .map(rpm_to_rad_per_s)
-        .collect();
+    let speeds = args.rpm.speeds_rad_per_s();
     let cov = fe.covariance.as_ref();
     let a = fe_analysis(&fe.rotor, cov, &speeds, modes)?;
     let operating = match (args.operating_rpm, fe.scenario_speed) {
@@ -295,12 +300,7 @@ pub(super) fn run(args: &AnalyzeArgs, fe: FeInput) -> anyhow::Result<()> {
             .collect(),
         figures: figures.clone(),
     };
-    let path = args.out.join("analysis.json");
-    let mut out = Output::create(&path.display().to_string(), FileMode::Atomic)?;
-    serde_json::to_writer_pretty(&mut out, &json)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    std::io::Write::write_all(&mut out, b"\n")?;
-    out.commit()?;
+    write_analysis_json(&args.out, &json)?;
 
     let uncertainty = if cov.is_some() {
         "with standard deviations from the covariance"
@@ -314,60 +314,20 @@ pub(super) fn run(args: &AnalyzeArgs, fe: FeInput) -> anyhow::Result<()> {
         fe.scenario,
         n
     )?;
-    let g = args.rpm;
-    outln!("critical speeds ({}-{} rpm):", g.start, g.stop)?;
-    if a.critical.is_empty() {
-        outln!("  none")?;
-    }
-    for (k, c) in a.critical.iter().enumerate() {
-        outln!(
-            "  {}: {}  {}  mode {}  (log dec {})",
-            k + 1,
-            with_std(c.rpm(), c.std_rpm(), "rpm"),
-            whirl_name(c.whirl()),
-            c.mode,
-            c.at.log_dec
-                .map_or("-".into(), |d| with_std_fixed(d, c.log_dec_std, 4))
-        )?;
-    }
-    let st = &a.stability;
-    match (st.threshold, st.min_log_dec) {
-        (None, Some(d)) => outln!(
-            "stability: stable over the range; minimum log decrement {d:.4} (mode {} at {:.0} rpm)",
-            st.min_log_dec_mode.unwrap_or(0),
-            rad_per_s_to_rpm(st.min_log_dec_speed.unwrap_or(0.0))
-        )?,
-        (None, None) => outln!("stability: stable over the range")?,
-        (Some(_), _) => {
-            let text = instability_text(st, true);
-            outln!("stability: {text}")?;
-            eprintln!("warning: {text}");
-        }
-    }
+    print_critical_speeds(args.rpm, &a.critical, |c| format!("  mode {}", c.mode))?;
+    let name = |j: usize| format!("mode {j}");
+    print_stability(
+        &a.stability,
+        &name,
+        &instability_text(&a.stability, &name, true),
+    )?;
     if let Some((m, src)) = &operating {
-        let rpm = rad_per_s_to_rpm(m.speed);
-        let d = m
-            .log_dec()
-            .map_or("- (the mode does not oscillate)".into(), |d| {
-                with_std_fixed(d, m.log_dec_std, 4)
-            });
-        outln!(
-            "stability margin at {rpm:.1} rpm ({}): log decrement {d} of the least damped mode \
-             (mode {} of the lowest {modes}, {})",
-            if *src == "given" {
-                "--operating-rpm"
-            } else {
-                "the scenario's speed"
-            },
+        let which = format!(
+            "mode {} of the lowest {modes}, {}",
             m.mode,
             whirl_name(m.at.whirl)
-        )?;
-        if m.is_unstable() {
-            eprintln!(
-                "warning: the rotor is UNSTABLE at the operating speed {rpm:.1} rpm: the {} mode's log decrement is {d}",
-                whirl_name(m.at.whirl)
-            );
-        }
+        );
+        print_margin(m, src, &which)?;
     }
     for u in &unbalances {
         let deg = |s: Option<f64>| s.map(f64::to_degrees);
