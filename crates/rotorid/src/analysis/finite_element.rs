@@ -24,8 +24,12 @@
 //! with u and r the right and left null vectors of Q(lambda) (Q u ~ 0, r Q ~ 0, no
 //! conjugation), each one step of inverse iteration, both from one complex LU with
 //! partial pivoting of Q(lambda) (the `complex_lu` module; r from its transposed solve). A
-//! mode is an eigenvalue with Im lambda > 0 (overdamped, real eigenvalues have no damped
-//! natural frequency and are left out); per mode, as for the 2-DOF models: damped natural
+//! mode is an eigenvalue with Im lambda > 0 and a damping ratio below 0.9
+//! ([`MAX_DAMPING_RATIO`]): overdamped, real eigenvalues have no damped natural frequency
+//! and are left out, and so are nearly real ones, whose imaginary part is rounding or the
+//! small split the gyroscopic coupling gives an overdamped pair (a shaft with proportional
+//! damping C = a M + b K has such pairs among its high modes; followed as modes, they
+//! crowded the candidates and produced spurious critical speeds near 0 rpm); per mode, as for the 2-DOF models: damped natural
 //! frequency w_d = Im lambda, damping ratio -Re lambda / |lambda|, logarithmic decrement
 //! -2 pi Re lambda / Im lambda.
 //!
@@ -102,6 +106,11 @@ const EXTRA_CANDIDATES: usize = 4;
 
 /// Two eigenvalues closer than this (relative) are one double eigenvalue.
 const DOUBLE: f64 = 1e-8;
+
+/// Eigenvalues damped above this ratio (-Re lambda / |lambda|; a logarithmic decrement of
+/// 13.7) are not modes: a real, overdamped pair that rounding or the gyroscopic coupling
+/// gives a tiny imaginary part (module doc).
+pub const MAX_DAMPING_RATIO: f64 = 0.9;
 
 /// A root is refined until its bracket is narrower than this fraction of the speed.
 const BRACKET: f64 = 1e-13;
@@ -304,7 +313,8 @@ impl Solver {
         self.sys.len()
     }
 
-    /// Every eigenvalue at speed `w` with Im lambda > 0, by increasing Im lambda (module doc).
+    /// Every eigenvalue at speed `w` with Im lambda > 0 and a damping ratio below
+    /// [`MAX_DAMPING_RATIO`], by increasing Im lambda (module doc).
     fn eigenvalues(&self, w: f64) -> Vec<C64> {
         let n = self.n();
         let a = DMatrix::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
@@ -319,7 +329,7 @@ impl Solver {
             .complex_eigenvalues()
             .iter()
             .copied()
-            .filter(|l| l.im > 0.0)
+            .filter(|l| l.im > 0.0 && -l.re < MAX_DAMPING_RATIO * l.norm())
             .collect();
         ev.sort_by(|a, b| a.im.total_cmp(&b.im));
         ev

@@ -75,7 +75,7 @@ pub use critical::{critical_speeds, CriticalSpeed};
 pub use error::AnalysisError;
 pub use finite_element::{
     fe_analysis, fe_stability_margin, fe_unbalances, FeAnalysis, FeCampbell, FeCovariance,
-    FeUnbalanceEstimate,
+    FeUnbalanceEstimate, MAX_DAMPING_RATIO,
 };
 pub use modes::{campbell, modes, Campbell, Mode, Whirl, PLANAR_WHIRL};
 pub use one_x::{one_x, synchronous_average, OneX};

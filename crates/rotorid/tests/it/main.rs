@@ -17,6 +17,7 @@ mod cross_modulating;
 mod cross_pipeline;
 mod cross_reference;
 mod defects;
+mod fe_analysis;
 mod fe_cross;
 mod fe_reduction;
 mod fe_refine;
