@@ -47,16 +47,7 @@ const TRUTH: [(&str, f64); 10] = [
 /// `rotorid simulate --scenario TOML --raw` into DIR/raw.csv.
 fn raw_record(dir: &std::path::Path, toml: &str) -> std::path::PathBuf {
     let raw = dir.join("raw.csv");
-    let out = crate::common::rotorid()
-        .args(["simulate", "--scenario", toml, "--raw", "-q", "--out"])
-        .arg(&raw)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    std::fs::write(&raw, simulate(&["--scenario", toml, "--raw"])).unwrap();
     raw
 }
 
