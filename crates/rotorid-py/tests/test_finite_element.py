@@ -39,19 +39,28 @@ def record():
     return rotorid.simulate(rotorid.Scenario(**CROSS), snr_db=40, seed=5)
 
 
-def test_identify_finite_element_equals_the_cross_coupled_refine(fe_scenario, record):
+#: finite-element name, 2-DOF name, and the shift of the angle (x = x, y = -z)
+PAIRS = [("bearing0.kxx", "kxx", 0.0), ("bearing0.kyy", "kzz", 0.0),
+         ("bearing0.cxx", "cxx", 0.0), ("bearing0.cyy", "czz", 0.0),
+         ("unbalance0.mud", "mud", 0.0), ("unbalance0.alpha", "alpha", -math.pi / 2)]
+
+
+@pytest.fixture(scope="module")
+def two_dof(record):
+    """The 2-DOF cross-coupled refine of the record (the independent code), by parameter."""
+    two = rotorid.identify(record, rotorid.Scenario(**CROSS), method="refine", model="cross_coupled",
+                           unknowns=["cxx", "czz", "kxx", "kzz", "unbalance"])
+    return {p["parameter"]: p for p in two.to_dict()["parameters"]}
+
+
+def test_identify_finite_element_equals_the_cross_coupled_refine(fe_scenario, record, two_dof):
     fe_data = {"t": record.t.to_numpy(), "0.x": record.x.to_numpy(), "0.y": -record.z.to_numpy()}
     s = rotorid.identify_finite_element(fe_data, fe_scenario)
     assert s["model"] == "finite_element" and s["converged"] and s["identifiable"]
     assert s["adequacy"]["model_adequate"]
-    two = rotorid.identify(record, rotorid.Scenario(**CROSS), method="refine", model="cross_coupled",
-                           unknowns=["cxx", "czz", "kxx", "kzz", "unbalance"])
-    ref = {p["parameter"]: p for p in two.to_dict()["parameters"]}
+    ref = two_dof
     got = {p["parameter"]: p for p in s["parameters"]}
-    for fe, xz, shift in [("bearing0.kxx", "kxx", 0.0), ("bearing0.kyy", "kzz", 0.0),
-                          ("bearing0.cxx", "cxx", 0.0), ("bearing0.cyy", "czz", 0.0),
-                          ("unbalance0.mud", "mud", 0.0),
-                          ("unbalance0.alpha", "alpha", -math.pi / 2)]:
+    for fe, xz, shift in PAIRS:
         a, b = got[fe], ref[xz]
         assert abs(a["value"] - (b["estimate"] + shift)) < 0.01 * a["std_error"], (fe, a, b)
         assert a["std_error"] == pytest.approx(b["std_error"], rel=0.01), fe
@@ -77,7 +86,7 @@ def test_identify_finite_element_refuses_by_name(fe_scenario, record):
         rotorid.identify_finite_element({"0.x": data["0.x"]}, fe_scenario)
 
 
-def test_offsets_absorb_a_removed_dc(fe_scenario, record):
+def test_offsets_absorb_a_removed_dc(fe_scenario, record, two_dof):
     # the record with a constant added to each channel (a DC removed, or a gap voltage
     # subtracted, by the user's own conditioning): with offsets=True the fit reports the
     # constants within their standard errors and the 2-DOF refine's estimates on the
@@ -90,14 +99,9 @@ def test_offsets_absorb_a_removed_dc(fe_scenario, record):
     assert [o["channel"] for o in s["offsets"]] == ["0.x", "0.y"]
     for o in s["offsets"]:
         assert abs(o["value"] - shift[o["channel"]]) < 4 * o["std_error"], o
-    two = rotorid.identify(record, rotorid.Scenario(**CROSS), method="refine", model="cross_coupled",
-                           unknowns=["cxx", "czz", "kxx", "kzz", "unbalance"])
-    ref = {p["parameter"]: p for p in two.to_dict()["parameters"]}
+    ref = two_dof
     got = {p["parameter"]: p for p in s["parameters"]}
-    for fe, xz, shift_angle in [("bearing0.kxx", "kxx", 0.0), ("bearing0.kyy", "kzz", 0.0),
-                                ("bearing0.cxx", "cxx", 0.0), ("bearing0.cyy", "czz", 0.0),
-                                ("unbalance0.mud", "mud", 0.0),
-                                ("unbalance0.alpha", "alpha", -math.pi / 2)]:
+    for fe, xz, shift_angle in PAIRS:
         a, b = got[fe], ref[xz]
         assert abs(a["value"] - (b["estimate"] + shift_angle)) < 0.5 * a["std_error"], (fe, a, b)
     plain = rotorid.identify_finite_element(data, fe_scenario)
