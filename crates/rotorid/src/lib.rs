@@ -27,6 +27,7 @@ pub mod refine;
 #[cfg(feature = "toml")]
 pub mod scenario_file;
 pub mod simulate;
+pub mod transient;
 #[cfg(feature = "test-models")]
 pub mod test_models;
 

@@ -1,0 +1,20 @@
+//! Machine transients from measurement: a run-up or a coast-down (probes in volts and a
+//! keyphasor) reduced to order-tracked vectors (Bode and polar data), slow-roll
+//! compensated, with the critical speeds, their API 684 amplification factors and
+//! separation margins, and cascades of spectra (docs/transient.md).
+//!
+//! - [`order`]: the keyphasor's shaft angle and each probe's nX vector per revolution
+//!   (or per speed bin), with its standard deviation from the noise of that revolution;
+//! - [`slow_roll`]: the runout vector (from a slow-roll record or a low-speed range) and
+//!   its subtraction;
+//! - [`critical`]: resonances of a 1X amplitude curve, half-power speeds, amplification
+//!   factors and separation margins (API 684);
+//! - [`spectrum`]: cascades (waterfalls) of spectra of one probe and full spectra of an
+//!   XY pair against speed.
+//!
+//! Pure computation, as the rest of the library: the caller reads the records.
+
+mod error;
+// pub mod spectrum;  (cascades: being written)
+
+pub use error::TransientError;
