@@ -18,6 +18,7 @@
 //! rotor-cojinete simplificado de dos grados de libertad", 2024; M. Lalanne, G. Ferraris,
 //! *Rotordynamics prediction in engineering*, 2nd ed., Wiley, 1998.
 
+pub mod description;
 mod error;
 pub mod finite_element;
 mod rotor;
