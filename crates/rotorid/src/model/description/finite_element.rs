@@ -267,10 +267,13 @@ impl RotorDescription for FiniteElementDescription {
 }
 
 /// Smallest over largest diagonal entry of the Cholesky factor below which T^T M T counts
-/// as singular (its condition number above 1e16): the basis has dependent columns.
-const DEPENDENT: f64 = 1e-8;
+/// as singular (its condition number above about 1e12): the basis has (nearly) dependent
+/// columns. Above rounding: a factor of exactly dependent columns has its entry at about
+/// sqrt(machine epsilon) = 1.5e-8 or fails.
+const DEPENDENT: f64 = 1e-6;
 
-/// True when the symmetric `m` is positive definite with condition number below 1e16.
+/// True when the symmetric `m` is positive definite with condition number below about
+/// 1e12 ([`DEPENDENT`]).
 fn independent(m: &DMatrix<f64>) -> bool {
     m.clone().cholesky().is_some_and(|c| {
         let d = c.l_dirty().diagonal();

@@ -474,15 +474,22 @@ fn finite_element_errors_carry_the_offending_values() {
     );
     let t = RitzBasis::new(&r, 2).unwrap();
     let c0 = t.matrix().column(0).into_owned();
-    let dependent = DMatrix::from_columns(&[c0.clone(), c0 * 2.0]);
-    assert!(matches!(
-        FiniteElementDescription::reduced(&r, &dependent, &[]),
-        Err(DescriptionError::Basis {
-            rows: 12,
-            cols: 2,
-            ..
-        })
-    ));
+    let dependent = DMatrix::from_columns(&[c0.clone(), c0.clone() * 2.0]);
+    // and a basis whose columns are nearly dependent: T^T M T = [[1, 1], [1, 1 + 1e-14]]
+    // (c0, c1 M-orthonormal) is positive definite to Cholesky (its factor's last diagonal
+    // entry 1e-7, far above rounding) with condition number 4e14
+    let c1 = t.matrix().column(1).into_owned();
+    let nearly = DMatrix::from_columns(&[c0.clone(), c0 + c1 * 1e-7]);
+    for t in [dependent, nearly] {
+        assert!(matches!(
+            FiniteElementDescription::reduced(&r, &t, &[]),
+            Err(DescriptionError::Basis {
+                rows: 12,
+                cols: 2,
+                ..
+            })
+        ));
+    }
     let d = FiniteElementDescription::full(&r, &[]).unwrap();
     assert_eq!(d.output_map().shape(), (0, 12));
     assert_eq!(d.index_by_name("unbalance1.alpha"), Ok(19));
