@@ -206,4 +206,4 @@ fn check_index(j: usize, n: usize) -> Result<(), DescriptionError> {
 }
 
 #[cfg(test)]
-pub(crate) mod tests;
+mod tests;
