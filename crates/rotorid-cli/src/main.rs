@@ -62,6 +62,9 @@ enum Command {
     Balance(Box<commands::balance::BalanceArgs>),
     /// The 1X vector of each probe of raw records (probes, keyphasor) as vectors.csv rows.
     Onex(commands::onex::OnexArgs),
+    /// A run-up or coast-down: Bode, polar and cascade plots, critical speeds with API 684
+    /// amplification factors and separation margins.
+    Transient(commands::transient::TransientArgs),
     /// Turn a raw acquisition (probe volts, keyphasor, slow roll) into a response CSV.
     Condition(commands::condition::ConditionArgs),
     /// List the channels of a record (CSV, MAT, TDMS, UFF58, NPY/NPZ, Parquet).
@@ -84,6 +87,7 @@ fn main() {
         Command::Predict(args) => commands::predict::run(args),
         Command::Balance(args) => commands::balance::run(*args),
         Command::Onex(args) => commands::onex::run(args),
+        Command::Transient(args) => commands::transient::run(args),
         Command::Condition(args) => commands::condition::run(args),
         Command::Inspect(args) => commands::inspect::run(args),
         Command::Publish(args) => commands::publish::run(args),

@@ -14,4 +14,5 @@ pub mod plot;
 pub mod predict;
 pub mod publish;
 pub mod simulate;
+pub mod transient;
 pub mod worker;

@@ -27,4 +27,5 @@ mod refine;
 mod safety;
 mod scenario;
 mod simulate;
+mod transient;
 mod units;

@@ -75,7 +75,7 @@ pub struct MassRow {
 }
 
 /// A text field, trimmed; empty is an error.
-fn text_field(
+pub(super) fn text_field(
     file: &str,
     rec: &Record<'_>,
     line: u64,
@@ -106,7 +106,7 @@ fn text_field(
 }
 
 /// A number in a range.
-fn ranged(
+pub(super) fn ranged(
     file: &str,
     rec: &Record<'_>,
     line: u64,
@@ -130,7 +130,7 @@ fn ranged(
 }
 
 /// Read the header of `csv`, or the error of an empty file.
-fn header<R: Read>(
+pub(super) fn header<R: Read>(
     file: &str,
     csv: &mut super::columns::CsvReader<R>,
     what: &str,
@@ -149,7 +149,7 @@ fn header<R: Read>(
 
 /// Call `row` for every non-blank data row of `csv` (as long as the header `h`) with its
 /// line.
-fn each_row<R: Read>(
+pub(super) fn each_row<R: Read>(
     file: &str,
     csv: &mut super::columns::CsvReader<R>,
     h: &Header,

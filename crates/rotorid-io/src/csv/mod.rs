@@ -14,6 +14,7 @@
 //!   bit for bit).
 
 pub mod balance;
+pub mod bode;
 pub mod columns;
 pub mod decimal;
 pub mod error;

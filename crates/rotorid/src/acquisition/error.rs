@@ -53,6 +53,12 @@ pub enum AcquisitionError {
         /// The length of the first column used.
         expected: usize,
     },
+    /// One probe where two are needed (x and z).
+    #[error("[acquisition] names one probe ({column}): x and z need two [[acquisition.probe]] at least 30 deg apart (one probe is enough for rotorid transient)")]
+    SingleProbe {
+        /// The probe's column.
+        column: String,
+    },
     /// A NaN or infinite sample.
     #[error("{which}: column \"{column}\" sample {index} (t = {t} s) is {value}: every sample must be a finite number")]
     NonFinite {

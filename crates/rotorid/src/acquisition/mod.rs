@@ -134,6 +134,11 @@ pub struct Acquisition {
     pub runout_harmonics: usize,
     /// Settings of the raw simulation (`[acquisition.simulate]`).
     pub simulate: RawSettings,
+    /// The scenario names one probe only (`probes` holds it twice): enough for the
+    /// transient analysis of that probe, refused by [`Acquisition::validate`] (x and z need
+    /// two).
+    #[serde(skip)]
+    pub single_probe: bool,
 }
 
 impl Acquisition {
@@ -164,6 +169,7 @@ impl Acquisition {
             slow_roll: None,
             runout_harmonics: DEFAULT_RUNOUT_HARMONICS,
             simulate: RawSettings::default(),
+            single_probe: false,
         }
     }
 
@@ -182,6 +188,11 @@ impl Acquisition {
     /// Check the settings that do not depend on data: probe separation, sensitivities,
     /// angles, rate, harmonics.
     pub fn validate(&self) -> Result<(), AcquisitionError> {
+        if self.single_probe {
+            return Err(AcquisitionError::SingleProbe {
+                column: self.probes[0].column.clone(),
+            });
+        }
         if let TimeBase::RateHz(r) = self.time {
             check("acquisition.rate_hz", r, "finite and > 0 (Hz)", |v| v > 0.0)?;
         }
@@ -646,7 +657,7 @@ pub fn time_of(
 /// (0.5 us with 6 decimals, 3e-5 rad at 650 rpm), the same way on every record: on a
 /// 600 rpm + 10 rad/s^2 run-up that biased m and k by 1.4 Cramer-Rao bounds (measured,
 /// docs/acquisition.md section 9).
-fn keyphasor_times(t: Vec<f64>) -> (Vec<f64>, Option<crate::pipeline::TimeGrid>) {
+pub(crate) fn keyphasor_times(t: Vec<f64>) -> (Vec<f64>, Option<crate::pipeline::TimeGrid>) {
     match crate::pipeline::TimeGrid::fit(&t, crate::pipeline::DEFAULT_TIME_TOLERANCE) {
         Ok(g) if g.rounded => ((0..t.len()).map(|i| g.time(i)).collect(), Some(g)),
         _ => (t, None),
@@ -654,7 +665,7 @@ fn keyphasor_times(t: Vec<f64>) -> (Vec<f64>, Option<crate::pipeline::TimeGrid>)
 }
 
 /// The probe voltages and keyphasor of `raw`, checked against its time stamps.
-fn channels<'a>(
+pub(crate) fn channels<'a>(
     raw: &'a RawRecord,
     acq: &Acquisition,
     t: &[f64],

@@ -391,12 +391,15 @@ impl Parser<'_> {
             ));
         };
         let tables = self.array_of_tables("acquisition.probe", pl, pv)?;
-        if tables.len() != 2 && model.is_some() {
+        // one probe of a lumped rotor: a valid record for `rotorid transient` only (the
+        // acquisition's `single_probe`; conditioning refuses it by name)
+        let single_probe = tables.len() == 1 && model.is_some();
+        if tables.len() != 2 && model.is_some() && !single_probe {
             return Err(ScenarioFileError::Inconsistent {
                 origin: self.origin.to_owned(),
                 line: pl,
                 message: format!(
-                    "acquisition.probe has {} tables: exactly two [[acquisition.probe]] are needed",
+                    "acquisition.probe has {} tables: exactly two [[acquisition.probe]] are needed (one is enough for rotorid transient)",
                     tables.len()
                 ),
             });
@@ -450,7 +453,12 @@ impl Parser<'_> {
             });
         }
         // The pairs: the two probes of a lumped rotor, or each node's two (file indices).
+        if single_probe {
+            probes_v.push(probes_v[0].clone());
+            angle_lines.push(angle_lines[0]);
+        }
         let pairs: Vec<Pair> = match model {
+            Some(_) if single_probe => Vec::new(),
             Some(_) => vec![(None, [0, 1])],
             None => self.node_pairs(&nodes, &probes_v)?,
         };
@@ -577,6 +585,7 @@ impl Parser<'_> {
                 slow_roll: slow_roll.clone(),
                 runout_harmonics: harmonics,
                 simulate: s,
+                single_probe,
             }
         };
         Ok(match model {
@@ -1043,6 +1052,49 @@ slow_roll = "slowroll.csv"
     }
 
     #[test]
+    fn an_acquisition_alone_and_one_probe_are_a_transient_record() {
+        // the contract without its [rotor]: a raw record's description, no model
+        let alone = CONTRACT.to_string();
+        let s = ScenarioSpec::parse("acq.toml", &alone).unwrap();
+        let a = s.acquisition().unwrap();
+        assert!(!a.single_probe);
+        a.validate().unwrap();
+        // what needs the rotor names what is missing
+        let e = s.rotor("the test").unwrap_err().to_string();
+        assert!(e.contains("rotor"), "{e}");
+        // one probe: parsed, refused by validate (conditioning) by name
+        let start = alone
+            .find("[[acquisition.probe]]\ncolumn = \"probe_R\"")
+            .unwrap();
+        let end = alone[start..].find("[acquisition.keyphasor]").unwrap() + start;
+        let one = format!("{}{}", &alone[..start], &alone[end..]);
+        let s = ScenarioSpec::parse("one.toml", &one).unwrap();
+        let a = s.acquisition().unwrap();
+        assert!(a.single_probe);
+        assert_eq!(a.probes[0].column, "probe_L");
+        let e = a.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("one probe (probe_L)") && e.contains("rotorid transient"),
+            "{e}"
+        );
+        // three probes are still refused
+        let three = alone.replacen(
+            "[acquisition.keyphasor]",
+            "[[acquisition.probe]]\ncolumn = \"p3\"\nangle_deg = 0.0\nsensitivity = 1.0\n\n[acquisition.keyphasor]",
+            1,
+        );
+        assert!(ScenarioSpec::parse("three.toml", &three).is_err());
+        // a [speed] without a [rotor] still needs the rotor
+        let e = ScenarioSpec::parse(
+            "s.toml",
+            &format!("[speed]\nkind = \"constant\"\nrpm = 1\n{alone}"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("missing section [rotor]"), "{e}");
+    }
+
+    #[test]
     fn rate_threshold_and_simulation_keys() {
         let text = CONTRACT
             .replace("time = \"t\"", "rate_hz = 25600")
@@ -1115,8 +1167,11 @@ slow_roll = "slowroll.csv"
         }
         // Only one probe.
         let one = CONTRACT.replacen("[[acquisition.probe]]\ncolumn = \"probe_R\"\nangle_deg = 45.0\nsensitivity_mv_per_mil = 200.0\n", "", 1);
-        let e = parse(&one).unwrap_err().to_string();
-        assert!(e.contains("exactly two"), "{e}");
+        // (parsed: enough for rotorid transient; conditioning refuses it by name)
+        let s = parse(&one).unwrap();
+        let a = s.acquisition().unwrap();
+        assert!(a.single_probe);
+        assert!(a.validate().unwrap_err().to_string().contains("one probe"));
     }
 
     /// A finite-element rotor's probes: grouped by node in the order the nodes first

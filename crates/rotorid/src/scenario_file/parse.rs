@@ -189,6 +189,14 @@ impl Parser<'_> {
         let speed = take("speed", &SPEED_KEYS[1..])?;
         let sampling = take("sampling", &SAMPLING_KEYS)?.map(|(s, _)| s);
         let initial = take("initial", &INITIAL_KEYS)?.map(|(s, _)| s);
+        // a scenario holding only [acquisition] describes a raw record for the analyses
+        // that need no model (`rotorid transient`); what needs the rotor asks for its keys
+        let acquisition_only = rotor.is_none() && acquisition.is_some() && speed.is_none();
+        let (rotor, check) = match rotor {
+            Some(r) => (Some(r), true),
+            None if acquisition_only => (Some(Section::default()), false),
+            None => (None, true),
+        };
         let Some(rotor) = rotor else {
             return Err(ScenarioFileError::MissingSection {
                 origin: self.origin(),
@@ -197,7 +205,7 @@ impl Parser<'_> {
                 needed_by: None,
             });
         };
-        if finite_element.is_none() {
+        if finite_element.is_none() && check {
             self.check_rotor(&rotor, model)?;
         }
         let speed = match speed {

@@ -14,7 +14,15 @@
 //!
 //! Pure computation, as the rest of the library: the caller reads the records.
 
+pub mod critical;
 mod error;
+pub mod order;
+pub mod record;
+pub mod slow_roll;
 // pub mod spectrum;  (cascades: being written)
 
+pub use critical::{criticals, separation_margin, Critical, CriticalSettings, Margin, Position};
 pub use error::TransientError;
+pub use order::{track, OrderSettings, Revolution, Tracked};
+pub use record::{track_record, ProbeTrack, RecordTrack};
+pub use slow_roll::{compensate, SlowRoll, SlowRollSource};
