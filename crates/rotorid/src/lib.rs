@@ -27,9 +27,9 @@ pub mod refine;
 #[cfg(feature = "toml")]
 pub mod scenario_file;
 pub mod simulate;
-pub mod transient;
 #[cfg(feature = "test-models")]
 pub mod test_models;
+pub mod transient;
 
 pub use model::{
     InitialState, Rotor, RotorParams, Sampling, Scenario, SpeedProfile, SpeedState, Unbalance,
