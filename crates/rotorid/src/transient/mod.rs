@@ -15,6 +15,7 @@
 //! Pure computation, as the rest of the library: the caller reads the records.
 
 mod error;
-// pub mod spectrum;  (cascades: being written)
+pub mod spectrum;
 
 pub use error::TransientError;
+pub use spectrum::{cascade, full_cascade, Cascade, CascadeSettings, Peak};
