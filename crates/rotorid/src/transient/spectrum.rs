@@ -12,7 +12,7 @@
 //! the start, last at the end; they overlap when the record is short). A record shorter
 //! than `lines` samples uses the longest power of two it holds, down to [`MIN_LINES`].
 //!
-//! Each block has its mean removed and is weighted by the periodic Hann window
+//! Each block has its (window-weighted) mean removed and is weighted by the periodic Hann window
 //! w\[i\] = (1 - cos(2 pi i / N)) / 2. Amplitudes are zero-to-peak in the signal's unit,
 //! corrected for the window's coherent gain (sum of w = N / 2): a sinusoid of amplitude A
 //! whose frequency falls on a line shows A on that line. Between two lines the Hann window
@@ -119,7 +119,7 @@ impl Cascade {
         } else {
             (-1.0, a[k - 1] / a[k])
         };
-        if !(a[k] > 0.0) {
+        if a[k] <= 0.0 || a[k].is_nan() {
             return Some(Peak {
                 freq_hz: self.freq_hz[k],
                 amplitude: 0.0,
@@ -421,9 +421,17 @@ impl Fft {
         }
     }
 
-    /// The DFT (lines 0 to n/2) of `block` with its mean removed, Hann-windowed.
+    /// The DFT (lines 0 to n/2) of `block` with its window-weighted mean removed,
+    /// Hann-windowed. Removing the plain mean would leave the mean of a non-whole number
+    /// of cycles as a spurious 0 Hz line (A / (2 pi cycles)); the weighted mean makes line
+    /// 0 exactly zero and leaves a sinusoid's leakage there as the window gives it.
     fn spectrum(&mut self, block: &[f64]) -> &[Complex<f64>] {
-        let mean = block.iter().sum::<f64>() / block.len() as f64;
+        let mean = block
+            .iter()
+            .zip(&self.window)
+            .map(|(v, w)| v * w)
+            .sum::<f64>()
+            / self.window.iter().sum::<f64>();
         for ((o, &v), &w) in self.input.iter_mut().zip(block).zip(&self.window) {
             *o = (v - mean) * w;
         }
@@ -489,6 +497,8 @@ mod tests {
                 c.rpm[s],
                 expect_rpm
             );
+            // the offset of 3 um and the mean of the part-cycles are gone: 0 Hz is zero
+            assert!(c.amplitude[s][0] < 1e-12 * a1, "{s}: {}", c.amplitude[s][0]);
             for (order, amp) in [(1.0, a1), (2.0, a2)] {
                 let f = order * c.rpm[s] / 60.0;
                 let p = c.order_peak(s, order).unwrap();
