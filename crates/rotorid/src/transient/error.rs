@@ -71,6 +71,21 @@ pub enum TransientError {
         /// The fewest samples per revolution that order needs.
         needed: usize,
     },
+    /// A time step that differs from the record's median step by more than the tolerance
+    /// (spectra need uniform sampling; a step <= 0 means the times do not increase).
+    #[error("{field}[{index}] - {field}[{prev}] = {dt:e} s but the median step is {median_dt:e} s: a spectrum needs uniform sampling (every step within {tolerance_pct} % of the median); resample the record first", prev = .index - 1)]
+    NonUniformSampling {
+        /// The time input (e.g. `t`).
+        field: &'static str,
+        /// Index of the sample that ends the step.
+        index: usize,
+        /// That step \[s\].
+        dt: f64,
+        /// The median step of the record \[s\].
+        median_dt: f64,
+        /// The largest deviation from the median accepted \[%\].
+        tolerance_pct: f64,
+    },
 }
 
 /// The first NaN or infinite value of `v`, as an error naming `field`.

@@ -19,10 +19,11 @@ mod error;
 pub mod order;
 pub mod record;
 pub mod slow_roll;
-// pub mod spectrum;  (cascades: being written)
+pub mod spectrum;
 
 pub use critical::{criticals, separation_margin, Critical, CriticalSettings, Margin, Position};
 pub use error::TransientError;
 pub use order::{track, OrderSettings, Revolution, Tracked};
 pub use record::{track_record, ProbeTrack, RecordTrack};
 pub use slow_roll::{compensate, SlowRoll, SlowRollSource};
+pub use spectrum::{cascade, full_cascade, Cascade, CascadeSettings, Peak};
