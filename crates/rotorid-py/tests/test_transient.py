@@ -49,6 +49,13 @@ The records take ~15 s each to generate (DOP853 at rtol 1e-10 on 33 s of motion)
 kept in a cache directory keyed by the generator's source and the numpy/scipy versions:
 $ROTORID_TRANSIENT_RIG_CACHE, else <tmp>/rotorid-transient-rig/<key>; set the variable to
 "off" to generate into the session's temporary directory instead.
+
+Run: crates/rotorid-py/test.sh runs it with the rest of tests/; without the rotorid Python
+package (only numpy, scipy, pytest and the binary):
+
+    ROTORID_BIN=target/debug/rotorid python -m pytest --noconftest crates/rotorid-py/tests/test_transient.py
+
+(-s prints the numbers behind each check).
 """
 
 from __future__ import annotations
@@ -111,6 +118,17 @@ def _record(cache: Path, name: str) -> Path:
         os.replace(tmp, path)
         print(f"\n[transient_rig] generated {name}.csv: {len(rec.t)} samples in {rec.seconds:.1f} s, "
               f"{path.stat().st_size / 1e6:.1f} MB")
+    return path
+
+
+@pytest.fixture(scope="session")
+def cli() -> str:
+    """The `rotorid` binary (ROTORID_BIN), as conftest.py's `cli`; repeated here so that this
+    module also runs with `pytest --noconftest` where the rotorid Python package (which
+    conftest.py imports) is not installed: it needs only numpy, scipy and the binary."""
+    path = os.environ.get("ROTORID_BIN")
+    if not path or not Path(path).is_file():
+        pytest.skip("ROTORID_BIN is not set to the built `rotorid` binary (crates/rotorid-py/test.sh sets it)")
     return path
 
 
