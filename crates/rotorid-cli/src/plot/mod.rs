@@ -16,8 +16,6 @@
 pub mod bode;
 pub mod campbell;
 pub mod canvas;
-// `rotorid transient` (being written) draws it; drop the allow when it does.
-#[allow(dead_code)]
 pub mod cascade;
 pub mod font;
 pub mod geometry;

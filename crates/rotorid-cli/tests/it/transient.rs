@@ -102,8 +102,11 @@ fn run_transient(args: &[&str]) -> (bool, String, String) {
     )
 }
 
-/// bode.csv rows: (speed_rpm, sensor, order, re, im, std, raw_re, raw_im).
-fn bode_rows(dir: &Path) -> Vec<(f64, String, u32, f64, f64, f64, f64, f64)> {
+/// A bode.csv row: (speed_rpm, sensor, order, re, im, std, raw_re, raw_im).
+type BodeRow = (f64, String, u32, f64, f64, f64, f64, f64);
+
+/// bode.csv's rows.
+fn bode_rows(dir: &Path) -> Vec<BodeRow> {
     let text = std::fs::read_to_string(dir.join("bode.csv")).unwrap();
     let mut lines = text.lines();
     assert_eq!(
@@ -212,7 +215,7 @@ fn run_up_criticals_amplification_factors_and_margins_match_the_steady_state() {
             .iter()
             .map(|r| amp(steady(r.0, angle)))
             .fold(0.0, f64::max);
-        let rms = |f: &dyn Fn(&&(f64, String, u32, f64, f64, f64, f64, f64)) -> f64| {
+        let rms = |f: &dyn Fn(&&BodeRow) -> f64| {
             (mine.iter().map(|r| f(r).powi(2)).sum::<f64>() / mine.len() as f64).sqrt()
         };
         let amp_rms = rms(&|r| amp((r.3, r.4)) - amp(steady(r.0, angle)));

@@ -19,7 +19,9 @@
 //! or the record's end) exceeds [`CriticalSettings::sigmas`] times the noise of that
 //! difference and [`CriticalSettings::min_relative_prominence`] of its height: a maximum
 //! made by noise is not a critical, and two resonances close together (a split critical)
-//! are two criticals when the dip between them is significant.
+//! are two criticals when the dip between them is significant. A peak whose half-power
+//! points lie closer to it than half the smoothing window is not resolved (ringing at the
+//! start of a record, a glitch) and is not reported.
 //!
 //! Nc and the peak amplitude are the vertex of a weighted quadratic fitted to the
 //! amplitudes within 90 % of the peak (at least 5 points); N1 and N2 are where a weighted
@@ -428,7 +430,15 @@ pub fn criticals(
             continue;
         }
         if let Some(c) = one_critical(&sm, &amp, &raw_amp, j, significance) {
-            out.push(c);
+            // a peak narrower than the smoothing window is not resolved: ringing at a
+            // record's start, a glitch (a resonance that sharp needs denser speeds)
+            let w = &sm.window[j];
+            let width = sm.rpm[w.end - 1] - sm.rpm[w.start];
+            let half_widths = [c.n1_rpm.map(|n| c.rpm - n), c.n2_rpm.map(|n| n - c.rpm)];
+            let resolved = half_widths.iter().flatten().all(|&h| h >= 0.5 * width);
+            if resolved {
+                out.push(c);
+            }
         }
     }
     Ok(out)
@@ -453,9 +463,7 @@ fn one_critical(
         hi += 1;
     }
     while hi - lo < 5 && (lo > 0 || hi < n) {
-        if lo > 0 {
-            lo -= 1;
-        }
+        lo = lo.saturating_sub(1);
         if hi - lo < 5 && hi < n {
             hi += 1;
         }

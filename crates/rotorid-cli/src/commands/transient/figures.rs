@@ -7,12 +7,14 @@ use std::path::Path;
 
 use rotorid::acquisition::probes::inverse_projection;
 use rotorid::transient::order::C64;
+use rotorid::transient::{cascade, full_cascade, Cascade, CascadeSettings};
 
 use super::output::lag_deg;
 use super::Analysis;
 use crate::plot::bode::{unwrap_deg, BodeChannel, BodePlot};
 use crate::plot::campbell::CriticalMark;
 use crate::plot::canvas::save_drawing;
+use crate::plot::cascade::CascadePlot;
 use crate::plot::polar::{PolarChannel, PolarPlot};
 use crate::plot::{palette, Figure, Panel, Rgb, Series};
 
@@ -33,6 +35,8 @@ pub struct Figures {
     bode: BodePlot,
     polar: PolarPlot,
     centreline: Option<Figure>,
+    /// (stem, caption, plot) of each cascade.
+    cascades: Vec<(String, String, CascadePlot)>,
 }
 
 /// Criticals closer than this fraction of their speed are one mark on the plots.
@@ -179,7 +183,90 @@ pub fn render(a: &Analysis) -> anyhow::Result<Figures> {
         bode,
         polar,
         centreline: centreline(a, &source)?,
+        cascades: cascades(a, &source)?,
     })
+}
+
+/// The spectra of every record joined (records of one event: the same sampling, so the
+/// same lines); `None` when they differ (then the first record's alone).
+fn joined(parts: Vec<Cascade>) -> Option<Cascade> {
+    let mut it = parts.into_iter();
+    let mut all = it.next()?;
+    for c in it {
+        if c.freq_hz != all.freq_hz {
+            return Some(all);
+        }
+        all.rpm.extend(c.rpm);
+        all.t.extend(c.t);
+        all.amplitude.extend(c.amplitude);
+    }
+    Some(all)
+}
+
+/// The cascade of each probe and, with an XY pair, the full-spectrum cascade (raw
+/// records only; the signals as measured, runout included).
+fn cascades(a: &Analysis, source: &str) -> anyhow::Result<Vec<(String, String, CascadePlot)>> {
+    if a.samples.is_empty() {
+        return Ok(Vec::new());
+    }
+    let settings = CascadeSettings::default();
+    let mut out = Vec::new();
+    for (k, s) in a.sensors.iter().enumerate() {
+        let parts = a
+            .samples
+            .iter()
+            .map(|r| cascade(&r.t, &r.omega, &r.displacement[k], &settings))
+            .collect::<Result<Vec<_>, _>>()?;
+        if let Some(c) = joined(parts) {
+            let mut plot =
+                CascadePlot::new(format!("Cascade \u{2014} {} \u{2014} {source}", s.name), c);
+            plot.orders.retain(|&o| o <= 10.0);
+            out.push((
+                format!("cascade_{}", file_stem_of(&s.name)),
+                format!("Cascade of {}: its spectra (\u{b5}m pk, colour) against speed, the orders as dashed lines (the signal as measured, runout included)", s.name),
+                plot,
+            ));
+        }
+    }
+    if let (Some(angles), 2) = (a.pair_angles, a.sensors.len()) {
+        let inv = inverse_projection(angles)?;
+        let parts = a
+            .samples
+            .iter()
+            .map(|r| {
+                let (x, z): (Vec<f64>, Vec<f64>) = r.displacement[0]
+                    .iter()
+                    .zip(&r.displacement[1])
+                    .map(|(&d1, &d2)| {
+                        let q = inv * nalgebra::Vector2::new(d1, d2);
+                        (q[0], q[1])
+                    })
+                    .unzip();
+                full_cascade(&r.t, &r.omega, &x, &z, &settings)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if let Some(c) = joined(parts) {
+            out.push((
+                "full_spectrum".to_string(),
+                format!("Full-spectrum cascade of the pair {} and {}: forward whirl (in the direction of rotation) at positive frequencies, backward at negative", a.sensors[0].name, a.sensors[1].name),
+                CascadePlot::new(format!("Full spectrum \u{2014} {source}"), c),
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// `name` with every character that is not a letter, digit, `-` or `_` replaced by `_`.
+fn file_stem_of(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
 
 /// The shaft centreline: x, z from the two probes' gaps (DC) through the inverse of the
@@ -207,8 +294,17 @@ fn centreline(a: &Analysis, source: &str) -> anyhow::Result<Option<Figure>> {
         return Ok(None);
     };
     let rpm: Vec<f64> = pts.iter().map(|p| p.0).collect();
-    let x: Vec<f64> = pts.iter().map(|p| (p.1 - x0) * 1e6).collect();
-    let z: Vec<f64> = pts.iter().map(|p| (p.2 - z0) * 1e6).collect();
+    // a running median over 21 revolutions: a revolution's gap carries a little of its
+    // vibration when that changes within the revolution (near a resonance on a sweep),
+    // which is no movement of the centre
+    let x = running_median(
+        &pts.iter().map(|p| (p.1 - x0) * 1e6).collect::<Vec<_>>(),
+        10,
+    );
+    let z = running_median(
+        &pts.iter().map(|p| (p.2 - z0) * 1e6).collect::<Vec<_>>(),
+        10,
+    );
     // speed labels: dots at a few speeds along the path
     let (lo, hi) = rpm
         .iter()
@@ -231,7 +327,7 @@ fn centreline(a: &Analysis, source: &str) -> anyhow::Result<Option<Figure>> {
         }
     }
     let path = Panel::new(
-        "centreline (from the first revolution; dots every equal speed step)",
+        "centreline (from the first revolution; median of 21 revolutions; dots at equal speed steps)",
         "x, horizontal (\u{b5}m)",
         "z, vertical up (\u{b5}m)",
     )
@@ -259,6 +355,18 @@ fn centreline(a: &Analysis, source: &str) -> anyhow::Result<Option<Figure>> {
     ))
 }
 
+/// The median of `v` over `2 half + 1` points around each (fewer at the ends).
+fn running_median(v: &[f64], half: usize) -> Vec<f64> {
+    let n = v.len();
+    (0..n)
+        .map(|i| {
+            let mut w: Vec<f64> = v[i.saturating_sub(half)..(i + half + 1).min(n)].to_vec();
+            w.sort_by(f64::total_cmp);
+            w[w.len() / 2]
+        })
+        .collect()
+}
+
 /// The step of 1, 2 or 5 times a power of ten nearest above `raw` (> 0).
 fn nice_step(raw: f64) -> f64 {
     if !(raw.is_finite() && raw > 0.0) {
@@ -276,7 +384,12 @@ impl Figures {
     /// The file names the figures are written to.
     pub fn names(&self) -> Vec<String> {
         let mut v = Vec::new();
-        for stem in self.stems() {
+        for stem in self
+            .stems()
+            .into_iter()
+            .map(str::to_owned)
+            .chain(self.cascades.iter().map(|c| c.0.clone()))
+        {
             for ext in ["png", "svg"] {
                 v.push(format!("{stem}.{ext}"));
             }
@@ -294,7 +407,8 @@ impl Figures {
 
     /// (stem, caption) of each figure, for the report.
     pub fn report_figures(&self) -> Vec<(String, String)> {
-        self.stems()
+        let mut v: Vec<(String, String)> = self
+            .stems()
             .into_iter()
             .map(|s| {
                 let caption = match s {
@@ -304,7 +418,9 @@ impl Figures {
                 };
                 (s.to_string(), caption.to_string())
             })
-            .collect()
+            .collect();
+        v.extend(self.cascades.iter().map(|(s, c, _)| (s.clone(), c.clone())));
+        v
     }
 
     /// Write every figure into `dir` as PNG and SVG; the names written.
@@ -314,6 +430,9 @@ impl Figures {
             save_drawing(&self.polar, (1400, 1000), &dir.join(format!("polar.{ext}")))?;
             if let Some(f) = &self.centreline {
                 crate::plot::save(f, &dir.join(format!("centreline.{ext}")))?;
+            }
+            for (stem, _, plot) in &self.cascades {
+                plot.save(&dir.join(format!("{stem}.{ext}")))?;
             }
         }
         Ok(self.names())

@@ -253,7 +253,7 @@ fn speed_check(rpm: impl Iterator<Item = f64>) -> Result<(), TransientError> {
     }
     let mean = sum / n.max(1) as f64;
     let change = (hi - lo) / mean * 100.0;
-    if n == 0 || !(change >= MIN_SPEED_CHANGE_PCT) {
+    if n == 0 || change.is_nan() || change < MIN_SPEED_CHANGE_PCT {
         return Err(TransientError::SpeedTooSteady {
             min_rpm: lo,
             max_rpm: hi,
