@@ -17,11 +17,16 @@
 //! A local maximum of the smooth amplitude is a resonance when its prominence (its height
 //! above the higher of the lowest points between it and a higher maximum on either side,
 //! or the record's end) exceeds [`CriticalSettings::sigmas`] times the noise of that
-//! difference and [`CriticalSettings::min_relative_prominence`] of its height: a maximum
-//! made by noise is not a critical, and two resonances close together (a split critical)
+//! difference, [`CriticalSettings::min_relative_prominence`] of its height and
+//! [`SCATTER_MULTIPLE`] times the scatter of single points there: a maximum made by noise
+//! is not a critical, and two resonances close together (a split critical)
 //! are two criticals when the dip between them is significant. A peak whose half-power
 //! points lie closer to it than half the smoothing window is not resolved (ringing at the
-//! start of a record, a glitch) and is not reported.
+//! start of a record, a glitch) and is not reported; nor is one that does not fall to half
+//! power on either side (a bump, or a critically damped response, AF < 2.5), or whose
+//! vector turns by less than [`MIN_PHASE_TURN_DEG`] between its half-power speeds (half
+//! that from the peak to the only one found): a resonance turns the phase, by about 90 deg
+//! between them for a single mode; a beat or a bump does not.
 //!
 //! Nc and the peak amplitude are the vertex of a weighted quadratic fitted to the
 //! amplitudes within 90 % of the peak (at least 5 points); N1 and N2 are where a weighted
@@ -43,6 +48,15 @@ use serde::Serialize;
 use super::error::{check_finite, same_length, TransientError};
 use super::order::C64;
 use crate::model::OutOfRange;
+
+/// A resonance's prominence must also exceed this many times the scatter of single
+/// points at its peak and base (module doc).
+pub const SCATTER_MULTIPLE: f64 = 3.0;
+
+/// The least turn of the vector between the half-power speeds of a resonance \[deg\]
+/// (about 90 for a single mode seen alone; a probe that also sees another mode's response
+/// sees less).
+pub const MIN_PHASE_TURN_DEG: f64 = 30.0;
 
 /// How resonances are told from noise.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -426,7 +440,13 @@ pub fn criticals(
         let prominence = a - b;
         let noise = sm.std[j].hypot(sm.std[bi]);
         let significance = prominence / noise.max(f64::MIN_POSITIVE);
-        if significance < settings.sigmas || prominence < settings.min_relative_prominence * a {
+        // a dense, noisy stretch makes smooth maxima that stand out of the smooth curve's
+        // own error but not out of the points' scatter: a resonance rises above both
+        let scatter = sm.noise[j].max(sm.noise[bi]);
+        if significance < settings.sigmas
+            || prominence < settings.min_relative_prominence * a
+            || prominence < SCATTER_MULTIPLE * scatter
+        {
             continue;
         }
         if let Some(c) = one_critical(&sm, &amp, &raw_amp, j, significance) {
@@ -548,6 +568,21 @@ fn one_critical(
     };
     let n1 = half(-1);
     let n2 = half(1);
+    // a resonance falls to half power on at least one side and turns the vector between
+    // its half-power speeds (by about 90 deg for a single mode, 45 from the peak to either);
+    // a maximum that does neither is a bump or a beat (or critically damped: AF < 2.5)
+    let at = |r: f64| sm.vector[sm.rpm.partition_point(|&x| x < r).min(n - 1)];
+    let turn = |a: C64, b: C64| (b / a).arg().abs().to_degrees();
+    let turned = match (n1, n2) {
+        (Some((a1, _)), Some((a2, _))) => turn(at(a1), at(a2)) >= MIN_PHASE_TURN_DEG,
+        (Some((a, _)), None) | (None, Some((a, _))) => {
+            turn(sm.vector[j], at(a)) >= 0.5 * MIN_PHASE_TURN_DEG
+        }
+        (None, None) => false,
+    };
+    if !turned {
+        return None;
+    }
     let (af, af_std) = match (n1, n2) {
         (Some((n1, s1)), Some((n2, s2))) if n2 > n1 => {
             let d = n2 - n1;
@@ -768,6 +803,35 @@ mod tests {
         )
         .unwrap();
         assert!(c.is_empty(), "{c:?}");
+    }
+
+    #[test]
+    fn a_bump_that_does_not_turn_the_phase_is_no_critical() {
+        // a bump of the amplitude to 3 times, the vector's direction fixed: a beat, no
+        // resonance; the same bump turning the phase by 90 deg across it is one; a bump of
+        // 40 %, which never falls to half power, is none either way
+        let rpm: Vec<f64> = (0..2000).map(|i| 1000.0 + f64::from(i)).collect();
+        let bump = |n: f64| 1e-5 * (1.0 + 2.0 * (-((n - 2000.0) / 60.0).powi(2)).exp());
+        let flat: Vec<C64> = rpm.iter().map(|&n| C64::new(bump(n), 0.0)).collect();
+        let std = vec![1e-9; rpm.len()];
+        let c = criticals(&rpm, &flat, &std, &CriticalSettings::default()).unwrap();
+        assert!(c.is_empty(), "{c:?}");
+        let small: Vec<C64> = rpm
+            .iter()
+            .map(|&n| {
+                let b = 1e-5 * (1.0 + 0.4 * (-((n - 2000.0) / 60.0).powi(2)).exp());
+                C64::from_polar(b, -(1.0 + ((n - 2000.0) / 60.0).tanh()) * 0.785)
+            })
+            .collect();
+        let c = criticals(&rpm, &small, &std, &CriticalSettings::default()).unwrap();
+        assert!(c.is_empty(), "{c:?}");
+        let turning: Vec<C64> = rpm
+            .iter()
+            .map(|&n| C64::from_polar(bump(n), -(1.0 + ((n - 2000.0) / 60.0).tanh()) * 0.785))
+            .collect();
+        let c = criticals(&rpm, &turning, &std, &CriticalSettings::default()).unwrap();
+        assert_eq!(c.len(), 1, "{c:?}");
+        assert!((c[0].rpm - 2000.0).abs() < 2.0);
     }
 
     #[test]

@@ -627,10 +627,11 @@ pub fn run(args: TransientArgs) -> anyhow::Result<()> {
         lo,
         hi,
         a.sensors[0].points.len(),
-        a.bin_rpm
-            .map_or(" (one per revolution)".to_string(), |w| format!(
-                " (bins of {w} rpm)"
-            ))
+        match (a.bin_rpm, a.keyphasor.is_empty()) {
+            (Some(w), _) => format!(" (bins of {w} rpm)"),
+            (None, false) => " (one per revolution)".to_string(),
+            (None, true) => " (the table's rows)".to_string(),
+        }
     )?;
     for s in &a.sensors {
         if let Some(sr) = &s.slow_roll {
