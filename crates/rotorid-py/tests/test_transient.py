@@ -1,4 +1,4 @@
-"""Acceptance test of `rotorid transient` (issue 37, "Done when", first item) on records made
+"""Acceptance test of `rotorid transient` on records made
 by an independent generator (tests/transient_rig.py: numpy/scipy only, no rotorid code).
 
 The rotor: a 2-DOF anisotropic Jeffcott rotor, m = 10 kg, kx = 4e6 N/m, kz = 6e6 N/m,
@@ -38,7 +38,7 @@ command's own output):
       criticals below the range), coast-down with 4000:5000 (both above: the other branch);
     - apparent peaks above REF's on the run-up, below on the coast-down (the sweep's bias:
       +0.26..+0.49 % and -0.26..-0.49 % by a perfect tracker on the noise-free motion).
-  transient.json modes[] (issue 37 Done when, checked only when the output has modes):
+  transient.json modes[] (checked only when the output has modes):
     natural speeds within 0.5 % and damping ratios within 20 % of the rotor's, each with a
     standard deviation.
   One probe (a scenario with probe_L only): succeeds, probe_L's two criticals, a note about
@@ -405,7 +405,7 @@ def test_runup_separation_margins(runup):
 
 
 def test_runup_apparent_peaks_lie_above_the_steady_state(runup, ref):
-    """The sweep's bias on a run-up (issue 37, "Why"): each reported critical above REF's
+    """The sweep's bias on a run-up: each reported critical above REF's
     peak speed (a perfect tracker: +0.26..+0.49 %)."""
     for probe in PROBES:
         for k, w in zip(sorted(runup.criticals(probe), key=lambda k: k["rpm"]), ref["peaks"][probe]):
@@ -413,12 +413,12 @@ def test_runup_apparent_peaks_lie_above_the_steady_state(runup, ref):
 
 
 def test_runup_modes(runup, ref):
-    """Issue 37 Done when (fitted modes): within 0.5 % in speed and 20 % in damping ratio of
+    """Fitted modes: within 0.5 % in speed and 20 % in damping ratio of
     the rotor's modes, each with a standard deviation. Skipped while transient.json has no
     modes."""
     modes = runup.json.get("modes")
     if not modes:
-        pytest.skip("transient.json has no modes[] (issue 37 item 3 not built yet)")
+        pytest.skip("transient.json has no modes[]: the transient mode fit is not built yet")
     modes = sorted(modes, key=lambda m: m["rpm"])
     assert len(modes) == 2, modes
     for m, (n, zeta) in zip(modes, ref["modes"]):

@@ -206,7 +206,7 @@ fn run_up_criticals_amplification_factors_and_margins_match_the_steady_state() {
             assert_eq!(c["unit"], "m");
         }
         // compensated 1X against the steady state: the amplitude's RMS error within 3 % of
-        // the peak (the measure), the vector's within 6 % (the phase too; what is
+        // the peak (the acceptance measure), the vector's within 6 % (the phase too; what is
         // left is the sweep's lag through the resonances, not noise)
         let rows = bode_rows(&res);
         let mine: Vec<_> = rows.iter().filter(|r| r.1 == sensor && r.2 == 1).collect();
