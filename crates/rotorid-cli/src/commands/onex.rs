@@ -251,7 +251,7 @@ pub fn run(args: OnexArgs) -> anyhow::Result<()> {
 }
 
 /// A text field for CSV: quoted when it holds a comma, quote or line end.
-fn csv_text(s: &str) -> String {
+pub(crate) fn csv_text(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {

@@ -10,6 +10,7 @@ use minijinja::Environment;
 use serde::Serialize;
 
 use super::{Analysis, Sensor};
+use crate::commands::onex::csv_text;
 use crate::io::number::format_f64;
 use crate::io::{FileMode, Output};
 
@@ -28,15 +29,6 @@ pub fn pm(value: f64, std: f64) -> String {
     }
     let d = (1.0 - std.log10().floor()).clamp(0.0, 12.0) as usize;
     format!("{value:.d$} \u{b1} {std:.d$}")
-}
-
-/// A text field for CSV: quoted when it holds a comma, quote or line end.
-fn csv_text(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_owned()
-    }
 }
 
 /// Phase lag \[deg\] of a vector in \[0, 360).
