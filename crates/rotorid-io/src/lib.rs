@@ -60,6 +60,7 @@ pub mod npz;
 pub mod num;
 mod par;
 pub mod parquet;
+pub mod raw;
 pub mod select;
 pub mod stream;
 pub mod table;

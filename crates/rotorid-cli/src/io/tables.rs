@@ -12,7 +12,6 @@ use rotorid::acquisition::{
 };
 use rotorid::pipeline::{Knowledge, Method};
 use rotorid::scenario_file::ScenarioSpec;
-use rotorid_io::units::{conversion, Quantity};
 use rotorid_io::{select, ColumnMap, Format, SiBlocks, SiColumns, Table};
 
 /// True when `input` is read whole as a table rather than streamed as a response CSV: a
@@ -117,53 +116,24 @@ pub fn fe_raw_record(table: &Table, acq: &FeAcquisition) -> anyhow::Result<RawRe
     raw_record_of(table, &roles, &common.time, &common.probes[0].column)
 }
 
-/// The raw record of `table` whose channels `roles` (column, role) are converted to SI; a
-/// time from the time axis of `first_probe` when `time` names no channel of the table.
+/// The raw record of `table` whose channels `roles` (column, role) are converted to SI
+/// (`rotorid_io::raw`, shared with the Python package); a time from the time axis of
+/// `first_probe` when `time` names no channel of the table, noted on stderr.
 fn raw_record_of(
     table: &Table,
     roles: &[(&str, &'static str)],
     time: &TimeBase,
     first_probe: &str,
 ) -> anyhow::Result<RawRecord> {
-    let roles: Vec<(&str, &str, Option<&str>)> = roles
-        .iter()
-        .map(|&(n, what)| (n, what, table.channel(n).map(|c| c.name.as_str())))
-        .collect();
-    let mut columns = Vec::with_capacity(table.channels.len() + 1);
-    for c in &table.channels {
-        let role = roles
-            .iter()
-            .find(|(_, _, found)| *found == Some(c.name.as_str()));
-        let mut data = c.data.clone();
-        let name = match role {
-            Some(&(name, what, _)) => {
-                let q = if what == "time" {
-                    Quantity::Time
-                } else {
-                    Quantity::Voltage
-                };
-                let conv = conversion(q, c.unit.as_deref())
-                    .with_context(|| format!("{}, channel {:?} ({what})", table.file, c.name))?;
-                conv.apply_all(&mut data);
-                name.to_string()
-            }
-            None => c.name.clone(),
-        };
-        columns.push((name, data));
-    }
-    if let TimeBase::Column(t) = time {
-        let probe = table.channel(first_probe);
-        if let (None, Some(axis), Some(probe)) =
-            (table.channel(t), probe.and_then(|p| p.axis), probe)
-        {
-            eprintln!(
-                "note: {}: time from the file's time axis of {:?} (no channel {t:?})",
-                table.file, probe.name
-            );
-            columns.push((t.clone(), axis.times(probe.data.len())));
-        }
-    }
-    Ok(RawRecord { columns })
+    let time = match time {
+        TimeBase::Column(t) => Some(t.as_str()),
+        TimeBase::RateHz(_) => None,
+    };
+    let raw = rotorid_io::raw::channels(table, roles, time, first_probe)?;
+    print_notes(&table.file, &raw.notes);
+    Ok(RawRecord {
+        columns: raw.columns,
+    })
 }
 
 /// The slow-roll record of `acq`, read from its path relative to the scenario file.
@@ -186,8 +156,7 @@ fn slow_roll_table(spec: &ScenarioSpec, acq: &Acquisition) -> anyhow::Result<Opt
     let Some(rel) = &acq.slow_roll else {
         return Ok(None);
     };
-    let base = Path::new(spec.origin()).parent().unwrap_or(Path::new("."));
-    let path = base.join(rel);
+    let path = rotorid_io::raw::beside(spec.origin(), rel);
     let table = read(&path.to_string_lossy())
         .with_context(|| format!("the slow-roll record of [acquisition.runout] ({rel})"))?;
     Ok(Some(table))

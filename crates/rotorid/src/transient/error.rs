@@ -77,6 +77,14 @@ pub enum TransientError {
         /// The fewest samples per revolution that order needs.
         needed: usize,
     },
+    /// An error of one input or step (a record, a table's sensor), named first.
+    #[error("{input}: {source}")]
+    Within {
+        /// The input or step (`runup.csv: order tracking`).
+        input: String,
+        /// What went wrong there.
+        source: Box<TransientError>,
+    },
     /// A time step that differs from the record's median step by more than the tolerance
     /// (spectra need uniform sampling; a step <= 0 means the times do not increase).
     #[error("{field}[{index}] - {field}[{prev}] = {dt:e} s but the median step is {median_dt:e} s: a spectrum needs uniform sampling (every step within {tolerance_pct} % of the median); resample the record first", prev = .index - 1)]

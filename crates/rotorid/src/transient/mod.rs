@@ -17,19 +17,23 @@
 //!
 //! Pure computation, as the rest of the library: the caller reads the records.
 
+pub mod analysis;
 pub mod critical;
 mod error;
 pub mod modes;
 pub mod order;
 pub mod record;
+pub mod report;
 pub mod slow_roll;
 pub mod spectrum;
 pub mod synchronous;
 
+pub use analysis::{Analysis, RawAnalysis, SlowRollChoice};
 pub use critical::{criticals, separation_margin, Critical, CriticalSettings, Margin, Position};
 pub use error::TransientError;
 pub use modes::{fit_modes, FitBasis, FittedMode, ModeFit, ModeGuess, ModeSettings};
 pub use order::{track, OrderSettings, Revolution, Tracked};
 pub use record::{track_record, ProbeTrack, RecordTrack};
+pub use report::{transient_json, TransientJson};
 pub use slow_roll::{compensate, SlowRoll, SlowRollSource};
 pub use spectrum::{cascade, full_cascade, Cascade, CascadeSettings, Peak};

@@ -6,11 +6,11 @@
 use std::path::Path;
 
 use rotorid::acquisition::probes::inverse_projection;
+use rotorid::transient::analysis::Analysis;
 use rotorid::transient::order::C64;
+use rotorid::transient::report::lag_deg;
 use rotorid::transient::{cascade, full_cascade, Cascade, CascadeSettings};
 
-use super::output::lag_deg;
-use super::Analysis;
 use crate::plot::bode::{unwrap_deg, BodeChannel, BodePlot};
 use crate::plot::campbell::CriticalMark;
 use crate::plot::canvas::save_drawing;
@@ -99,7 +99,11 @@ pub fn render(a: &Analysis) -> anyhow::Result<Figures> {
     let mut all: Vec<(f64, f64)> = a
         .sensors
         .iter()
-        .flat_map(|s| s.criticals.iter().map(|(c, _)| (c.rpm, c.rpm_std)))
+        .flat_map(|s| {
+            s.criticals
+                .iter()
+                .map(|c| (c.critical.rpm, c.critical.rpm_std))
+        })
         .collect();
     all.sort_by(|x, y| x.0.total_cmp(&y.0));
     for (rpm, std) in all {

@@ -1,0 +1,140 @@
+//! Raw acquisitions (probe volts and a keyphasor, described by a scenario's
+//! `[acquisition]`, docs/acquisition.md) as named channels in SI, the one reading shared by
+//! the `rotorid` command and the Python package: every channel of the table by name, the
+//! ones the acquisition uses converted to SI from their units (time in s, probes and
+//! keyphasor in V). The caller hands the channels to `rotorid::acquisition::RawRecord`.
+//!
+//! An acquisition column names a channel as `--columns` does: exactly, else by its short
+//! name when that is unique (`probe_L` for a TDMS `rig/probe_L`); the channel then goes by
+//! the acquisition's name. Without a time channel, the file's time axis of the first probe
+//! (TDMS `wf_increment`, a UFF58 abscissa) gives it, t_i = start + i increment, with a
+//! note.
+
+use std::path::{Path, PathBuf};
+
+use crate::table::Table;
+use crate::units::{conversion, Quantity, UnitError};
+use crate::ReadError;
+
+/// The named SI channels of a raw record.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RawChannels {
+    /// (name, values), in file order; a time made from the file's time axis last.
+    pub columns: Vec<(String, Vec<f64>)>,
+    /// Notes about the file (each without the file name): [`channels`] notes a time
+    /// taken from the file's time axis, [`read`] also what the reader noted (an interrupted
+    /// recording's unfinished chunk), first.
+    pub notes: Vec<String>,
+}
+
+/// Why a raw record cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum RawError {
+    /// The file cannot be read.
+    #[error(transparent)]
+    Read(Box<ReadError>),
+    /// A channel the acquisition uses has a unit of another quantity, or an unknown one.
+    #[error("{file}, channel {channel:?} ({role}): {source}")]
+    Unit {
+        /// The file.
+        file: String,
+        /// The channel as the file names it.
+        channel: String,
+        /// What the acquisition uses it as (`time`, `probe 1`, `keyphasor`, ...).
+        role: String,
+        /// The unit's problem.
+        source: UnitError,
+    },
+    /// Context for an error: which record (`the slow-roll record of ...`).
+    #[error("{what}: {source}")]
+    Within {
+        /// The record.
+        what: String,
+        /// The error.
+        source: Box<RawError>,
+    },
+}
+
+impl From<ReadError> for RawError {
+    fn from(e: ReadError) -> Self {
+        Self::Read(Box::new(e))
+    }
+}
+
+/// The channels of `table` with `roles` ((column, role): role `time` in s, any other in V)
+/// converted to SI (module doc); `time_column` the acquisition's time column, if it has
+/// one (else a sampling rate), `first_probe` the column whose time axis stands in for a
+/// missing time channel.
+pub fn channels(
+    table: &Table,
+    roles: &[(&str, &str)],
+    time_column: Option<&str>,
+    first_probe: &str,
+) -> Result<RawChannels, RawError> {
+    let found: Vec<(&str, &str, Option<&str>)> = roles
+        .iter()
+        .map(|&(n, what)| (n, what, table.channel(n).map(|c| c.name.as_str())))
+        .collect();
+    let mut columns = Vec::with_capacity(table.channels.len() + 1);
+    for c in &table.channels {
+        let role = found.iter().find(|(_, _, f)| *f == Some(c.name.as_str()));
+        let mut data = c.data.clone();
+        let name = match role {
+            Some(&(name, what, _)) => {
+                let q = if what == "time" {
+                    Quantity::Time
+                } else {
+                    Quantity::Voltage
+                };
+                let conv = conversion(q, c.unit.as_deref()).map_err(|source| RawError::Unit {
+                    file: table.file.clone(),
+                    channel: c.name.clone(),
+                    role: what.to_owned(),
+                    source,
+                })?;
+                conv.apply_all(&mut data);
+                name.to_string()
+            }
+            None => c.name.clone(),
+        };
+        columns.push((name, data));
+    }
+    let mut notes = Vec::new();
+    if let Some(t) = time_column {
+        let probe = table.channel(first_probe);
+        if let (None, Some(axis), Some(probe)) =
+            (table.channel(t), probe.and_then(|p| p.axis), probe)
+        {
+            notes.push(format!(
+                "time from the file's time axis of {:?} (no channel {t:?})",
+                probe.name
+            ));
+            columns.push((t.to_owned(), axis.times(probe.data.len())));
+        }
+    }
+    Ok(RawChannels { columns, notes })
+}
+
+/// The file at `path` (any format [`crate::read_table`] reads) as [`channels`].
+pub fn read(
+    path: &str,
+    roles: &[(&str, &str)],
+    time_column: Option<&str>,
+    first_probe: &str,
+) -> Result<RawChannels, RawError> {
+    let table = crate::read_table(path)?;
+    let mut out = channels(&table, roles, time_column, first_probe)?;
+    let mut notes = table.notes;
+    notes.append(&mut out.notes);
+    out.notes = notes;
+    Ok(out)
+}
+
+/// The path of a file a scenario names (`[acquisition.runout] slow_roll`): relative to
+/// the scenario file `scenario_origin`'s directory (an absolute `rel` stays as it is).
+pub fn beside(scenario_origin: &str, rel: &str) -> PathBuf {
+    let base = Path::new(scenario_origin)
+        .parent()
+        .unwrap_or(Path::new("."));
+    base.join(rel)
+}

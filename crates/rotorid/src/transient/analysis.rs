@@ -1,0 +1,728 @@
+//! One transient analysis from its inputs (docs/transient.md): the order-tracked
+//! revolutions of a run-up or coast-down's raw records (or the rows of a 1X table), the
+//! slow-roll compensation chosen, the speed bins, the critical speeds of each sensor's
+//! compensated 1X with their API 684 separation margins, the sweep's direction and
+//! whether the probes are DC-coupled. Every caller (the `rotorid transient` command, the
+//! Python package) reads its files and hands the records here; [`super::report`] turns the
+//! [`Analysis`] into `transient.json` and the rows of `bode.csv`.
+//!
+//! Raw records: [`RawAnalysis::new`], then [`RawAnalysis::add_record`] for each record of
+//! the event in time order (tracked at once, so a caller can drop each record's samples
+//! before reading the next), then [`RawAnalysis::finish`] with the slow-roll choice. A
+//! 1X table: [`analyse_table`]. Pure computation: no file is read here.
+
+use serde::Serialize;
+
+use super::critical::{criticals, separation_margin, Critical, CriticalSettings, Margin};
+use super::error::TransientError;
+use super::order::{bin, OrderSettings, Tracked, C64};
+use super::record::track_record;
+use super::slow_roll::{self, SlowRoll, SlowRollSource};
+use crate::acquisition::{Acquisition, KeyphasorReport, RawRecord, Which};
+use crate::model::{rad_per_s_to_rpm, OutOfRange};
+
+/// The least relative speed change (max - min over the mean) of a Bode record \[%\].
+pub const MIN_SPEED_CHANGE_PCT: f64 = 10.0;
+
+/// A probe whose mean voltage reaches this magnitude \[V\] is taken as DC-coupled (a gap
+/// voltage; an AC-coupled channel averages to about 0 V).
+pub const DC_COUPLED_V: f64 = 0.5;
+
+/// What to compute, beyond the inputs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Settings {
+    /// The orders to track (raw records; a table is 1X) and the harmonics fitted.
+    pub order: OrderSettings,
+    /// Average the revolutions in speed bins of this width \[rev/min\] (raw records);
+    /// `None`: one point per revolution.
+    pub bin_rpm: Option<f64>,
+    /// The machine's operating speed range (min, max) \[rev/min\], for the API 684
+    /// separation margins; `None`: no margins.
+    pub operating_rpm: Option<(f64, f64)>,
+    /// How resonances are told from noise.
+    pub critical: CriticalSettings,
+}
+
+impl Default for Settings {
+    /// Orders 1 and 2, one point per revolution, no operating range.
+    fn default() -> Self {
+        Self {
+            order: OrderSettings::default(),
+            bin_rpm: None,
+            operating_rpm: None,
+            critical: CriticalSettings::default(),
+        }
+    }
+}
+
+impl Settings {
+    /// Check every setting against its allowed range.
+    pub fn validate(&self) -> Result<(), TransientError> {
+        self.order.validate()?;
+        if let Some(w) = self.bin_rpm {
+            if !(w.is_finite() && w > 0.0) {
+                return Err(OutOfRange {
+                    field: "bin_rpm",
+                    value: w,
+                    allowed: "finite and > 0 (rev/min)",
+                }
+                .into());
+            }
+        }
+        if let Some((lo, hi)) = self.operating_rpm {
+            if !(lo.is_finite() && lo > 0.0) {
+                return Err(OutOfRange {
+                    field: "operating_rpm min",
+                    value: lo,
+                    allowed: "finite and > 0 (rev/min; the margin is relative to it)",
+                }
+                .into());
+            }
+            if !(hi.is_finite() && hi > lo) {
+                return Err(OutOfRange {
+                    field: "operating_rpm max",
+                    value: hi,
+                    allowed: "finite and > the minimum (rev/min)",
+                }
+                .into());
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Where the runout subtracted from a raw record's vectors comes from
+/// (docs/transient.md section 3).
+#[derive(Debug, Clone, PartialEq)]
+pub enum SlowRollChoice {
+    /// The revolutions of a low speed range picked from the record
+    /// ([`slow_roll::auto_range`]).
+    Auto,
+    /// No compensation.
+    None,
+    /// The revolutions of this speed range (min, max) \[rev/min\].
+    Range(f64, f64),
+    /// A slow-roll record of the same acquisition; `label` names it (the file as given).
+    Record {
+        /// The file as the user gave it.
+        label: String,
+        /// Its channels.
+        record: RawRecord,
+    },
+}
+
+/// Whether the speed rises or falls over the record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// The speed rises.
+    RunUp,
+    /// The speed falls.
+    CoastDown,
+    /// Neither clearly (a run-up and a coast-down, or a record that wanders).
+    Mixed,
+}
+
+impl Direction {
+    /// `run_up`, `coast_down` or `mixed`, as in `transient.json`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::RunUp => "run_up",
+            Self::CoastDown => "coast_down",
+            Self::Mixed => "mixed",
+        }
+    }
+
+    /// The direction of the speeds `rpm` in time order: a run-up when the mean of the last
+    /// tenth exceeds that of the first by more than half the span, a coast-down the other
+    /// way round, else mixed.
+    pub fn of(rpm: &[f64]) -> Self {
+        let n = rpm.len();
+        if n < 2 {
+            return Self::Mixed;
+        }
+        let k = (n / 10).max(1);
+        let head = rpm[..k].iter().sum::<f64>() / k as f64;
+        let tail = rpm[n - k..].iter().sum::<f64>() / k as f64;
+        let (lo, hi) = min_max(rpm.iter().copied());
+        let span = hi - lo;
+        if tail - head > 0.5 * span {
+            Self::RunUp
+        } else if head - tail > 0.5 * span {
+            Self::CoastDown
+        } else {
+            Self::Mixed
+        }
+    }
+}
+
+/// One point of a sensor's Bode data.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Point {
+    /// Mid time of the revolution or bin \[s\] (None from a table).
+    pub t: Option<f64>,
+    /// Speed \[rev/min\].
+    pub rpm: f64,
+    /// Vectors per order as measured \[m\], zero-to-peak.
+    pub raw: Vec<C64>,
+    /// Vectors per order, runout subtracted \[m\], zero-to-peak.
+    pub comp: Vec<C64>,
+    /// Standard deviation of each of re and im of `comp` per order \[m\]; NaN unknown.
+    pub std: Vec<f64>,
+    /// The probe's gap (DC) \[m\], raw records only.
+    pub dc: Option<f64>,
+}
+
+/// A critical speed of a sensor's compensated 1X with its separation margin.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SensorCritical {
+    /// The critical (speeds \[rev/min\], amplitude \[m\]).
+    pub critical: Critical,
+    /// Its API 684 margin from the operating range, when one was given.
+    pub margin: Option<Margin>,
+}
+
+/// One sensor's data and results.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Sensor {
+    /// Its name (the probe's column, or the table's sensor).
+    pub name: String,
+    /// The probe's angle from +x towards +z \[deg\] (raw records).
+    pub angle_deg: Option<f64>,
+    /// The orders of each point's vectors.
+    pub orders: Vec<u32>,
+    /// The points, in time (or table) order.
+    pub points: Vec<Point>,
+    /// The runout subtracted \[m\].
+    pub slow_roll: Option<SlowRoll>,
+    /// Its criticals (1X), by speed, with their margins.
+    pub criticals: Vec<SensorCritical>,
+}
+
+impl Sensor {
+    /// The sweep rate \[rpm/s\] near `rpm`: the slope of speed against time over the
+    /// points within 2 % of it; `None` without times (a table) or with fewer than 3 such
+    /// points.
+    pub fn sweep_rate(&self, rpm: f64) -> Option<f64> {
+        let near: Vec<(f64, f64)> = self
+            .points
+            .iter()
+            .filter(|p| (p.rpm - rpm).abs() <= 0.02 * rpm)
+            .filter_map(|p| p.t.map(|t| (t, p.rpm)))
+            .collect();
+        if near.len() < 3 {
+            return None;
+        }
+        let n = near.len() as f64;
+        let (mt, mr) = near
+            .iter()
+            .fold((0.0, 0.0), |(a, b), (t, r)| (a + t / n, b + r / n));
+        let (sxy, sxx) = near.iter().fold((0.0, 0.0), |(a, b), (t, r)| {
+            (a + (t - mt) * (r - mr), b + (t - mt) * (t - mt))
+        });
+        (sxx > 0.0).then(|| sxy / sxx)
+    }
+}
+
+/// The samples of one raw record, for the spectra.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Samples {
+    /// Time \[s\].
+    pub t: Vec<f64>,
+    /// Shaft speed \[rad/s\].
+    pub omega: Vec<f64>,
+    /// Each probe's displacement towards it \[m\].
+    pub displacement: Vec<Vec<f64>>,
+}
+
+/// Everything a transient analysis computes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Analysis {
+    /// The inputs as given (file names).
+    pub sources: Vec<String>,
+    /// Whether the speed rises or falls.
+    pub direction: Direction,
+    /// The sensors, at least one.
+    pub sensors: Vec<Sensor>,
+    /// The keyphasor reports per record (raw records).
+    pub keyphasor: Vec<KeyphasorReport>,
+    /// Per sample data for the spectra, per record (raw records).
+    pub samples: Vec<Samples>,
+    /// Notes for the reader.
+    pub notes: Vec<String>,
+    /// The operating range \[rev/min\].
+    pub operating_rpm: Option<(f64, f64)>,
+    /// The bin width \[rev/min\].
+    pub bin_rpm: Option<f64>,
+    /// The probe angles \[rad\] of the XY pair, when two probes.
+    pub pair_angles: Option<[f64; 2]>,
+    /// Whether the probes are DC-coupled (their mean voltage is a gap voltage: at least
+    /// [`DC_COUPLED_V`] in magnitude on each).
+    pub dc_coupled: bool,
+}
+
+impl Analysis {
+    /// The speed range of all points (min, max) \[rev/min\].
+    pub fn speed_range(&self) -> (f64, f64) {
+        min_max(
+            self.sensors
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| p.rpm)),
+        )
+    }
+}
+
+fn min_max(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    })
+}
+
+/// `Ok` when the speeds `rpm` change by at least [`MIN_SPEED_CHANGE_PCT`] of their mean.
+pub fn speed_check(rpm: impl Iterator<Item = f64>) -> Result<(), TransientError> {
+    let (mut lo, mut hi, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0usize);
+    for r in rpm {
+        lo = lo.min(r);
+        hi = hi.max(r);
+        sum += r;
+        n += 1;
+    }
+    let mean = sum / n.max(1) as f64;
+    let change = (hi - lo) / mean * 100.0;
+    if n == 0 || change.is_nan() || change < MIN_SPEED_CHANGE_PCT {
+        return Err(TransientError::SpeedTooSteady {
+            min_rpm: lo,
+            max_rpm: hi,
+            change_pct: if change.is_finite() { change } else { 0.0 },
+            needed_pct: MIN_SPEED_CHANGE_PCT,
+        });
+    }
+    Ok(())
+}
+
+/// `e` as an error of `input` (a record, a sensor, a step), whose name comes first.
+fn within(input: impl Into<String>) -> impl FnOnce(TransientError) -> TransientError {
+    let input = input.into();
+    move |e| TransientError::Within {
+        input,
+        source: Box::new(e),
+    }
+}
+
+/// A run-up or coast-down's raw records, order-tracked as they are added (module doc).
+#[derive(Debug, Clone)]
+pub struct RawAnalysis<'a> {
+    acq: &'a Acquisition,
+    settings: Settings,
+    sources: Vec<String>,
+    tracked: Vec<Tracked>,
+    keyphasor: Vec<KeyphasorReport>,
+    samples: Vec<Samples>,
+}
+
+impl<'a> RawAnalysis<'a> {
+    /// An analysis of records described by `acq` (one or two probes), `settings` checked.
+    pub fn new(acq: &'a Acquisition, settings: Settings) -> Result<Self, TransientError> {
+        settings.validate()?;
+        Ok(Self {
+            acq,
+            settings,
+            sources: Vec::new(),
+            tracked: Vec::new(),
+            keyphasor: Vec::new(),
+            samples: Vec::new(),
+        })
+    }
+
+    /// The probes of the acquisition to track: both, or the one of a single-probe scenario.
+    fn probes(&self) -> &'static [usize] {
+        if self.acq.single_probe {
+            &[0]
+        } else {
+            &[0, 1]
+        }
+    }
+
+    /// Order-track the next record of the event, `source` naming it (errors start with
+    /// it: `runup.csv: order tracking: ...`).
+    pub fn add_record(&mut self, source: &str, raw: &RawRecord) -> Result<(), TransientError> {
+        let r = track_record(
+            raw,
+            self.acq,
+            self.probes(),
+            &self.settings.order,
+            Which::Running,
+        )
+        .map_err(within(format!("{source}: order tracking")))?;
+        for (k, p) in r.probes.into_iter().enumerate() {
+            match self.tracked.get_mut(k) {
+                Some(t) => t.revolutions.extend(p.tracked.revolutions),
+                None => self.tracked.push(p.tracked),
+            }
+        }
+        self.sources.push(source.to_owned());
+        self.keyphasor.push(r.keyphasor);
+        self.samples.push(Samples {
+            t: r.t,
+            omega: r.omega,
+            displacement: r.displacement,
+        });
+        Ok(())
+    }
+
+    /// The runout of each probe per `choice` (docs/transient.md section 3), with the
+    /// notes it makes.
+    fn slow_roll(
+        &self,
+        choice: SlowRollChoice,
+        notes: &mut Vec<String>,
+    ) -> Result<Vec<Option<SlowRoll>>, TransientError> {
+        let from_range = |a: f64, b: f64, source: SlowRollSource| {
+            self.tracked
+                .iter()
+                .map(|t| slow_roll::from_revolutions(t, a, b, source.clone()).map(Some))
+                .collect::<Result<Vec<_>, _>>()
+        };
+        match choice {
+            SlowRollChoice::None => {
+                notes.push(
+                    "no slow-roll compensation (--slow-roll none): the vectors are as measured"
+                        .into(),
+                );
+                Ok(vec![None; self.tracked.len()])
+            }
+            SlowRollChoice::Record { label, record } => {
+                let r = track_record(
+                    &record,
+                    self.acq,
+                    self.probes(),
+                    &self.settings.order,
+                    Which::SlowRoll,
+                )
+                .map_err(within(format!(
+                    "{label}: order tracking of the slow-roll record"
+                )))?;
+                r.probes
+                    .iter()
+                    .map(|p| slow_roll::from_record(&p.tracked, &label).map(Some))
+                    .collect::<Result<Vec<_>, _>>()
+                    .map_err(within(format!("{label}: the slow-roll record")))
+            }
+            SlowRollChoice::Range(a, b) => from_range(
+                a,
+                b,
+                SlowRollSource::Range {
+                    min_rpm: a,
+                    max_rpm: b,
+                },
+            )
+            .map_err(within("--slow-roll")),
+            SlowRollChoice::Auto => {
+                let all_rpm: Vec<f64> = self.tracked[0]
+                    .revolutions
+                    .iter()
+                    .map(|r| r.rpm())
+                    .collect();
+                let (a, b) = slow_roll::auto_range(&all_rpm).ok_or(TransientError::TooFew {
+                    what: "revolutions for an automatic slow roll".into(),
+                    found: 0,
+                    needed: 2,
+                })?;
+                notes.push(format!(
+                    "slow roll: the runout is taken from the revolutions from {a:.1} to {b:.1} rpm (the record's lowest speeds, picked automatically; --slow-roll FILE or RPM_MIN:RPM_MAX overrides)"
+                ));
+                from_range(
+                    a,
+                    b,
+                    SlowRollSource::Auto {
+                        min_rpm: a,
+                        max_rpm: b,
+                    },
+                )
+                .map_err(within("--slow-roll auto"))
+            }
+        }
+    }
+
+    /// The analysis of the records added, compensated per `slow_roll`: the speed checked
+    /// (it must change by [`MIN_SPEED_CHANGE_PCT`]), the points binned when asked, the
+    /// criticals with their margins.
+    pub fn finish(self, slow_roll: SlowRollChoice) -> Result<Analysis, TransientError> {
+        let acq = self.acq;
+        if self.tracked.is_empty() {
+            return Err(TransientError::TooFew {
+                what: "records of the transient".into(),
+                found: 0,
+                needed: 1,
+            });
+        }
+        speed_check(self.tracked[0].revolutions.iter().map(|r| r.rpm()))
+            .map_err(within(self.sources.join(", ")))?;
+        let mut notes = Vec::new();
+        if acq.single_probe {
+            notes.push(format!(
+                "one probe ({}): everything but the full spectrum and the shaft centreline (they need an XY pair)",
+                acq.probes[0].column
+            ));
+        }
+        let srs = self.slow_roll(slow_roll, &mut notes)?;
+        let mut sensors = Vec::new();
+        for (k, (t, sr)) in self.tracked.iter().zip(srs).enumerate() {
+            let comp = match &sr {
+                Some(s) => slow_roll::compensate(t, s),
+                None => t.clone(),
+            };
+            let (raw, comp) = match self.settings.bin_rpm {
+                Some(w) => (bin(t, w)?, bin(&comp, w)?),
+                None => (t.clone(), comp),
+            };
+            let points = raw
+                .revolutions
+                .iter()
+                .zip(&comp.revolutions)
+                .map(|(r, c)| Point {
+                    t: Some(0.5 * (r.t_start + r.t_end)),
+                    rpm: rad_per_s_to_rpm(c.speed),
+                    raw: r.vectors.clone(),
+                    comp: c.vectors.clone(),
+                    std: c.std.clone(),
+                    dc: Some(r.dc),
+                })
+                .collect();
+            let p = &acq.probes[k];
+            sensors.push(Sensor {
+                name: p.column.clone(),
+                angle_deg: Some(p.angle.to_degrees()),
+                orders: self.settings.order.orders.clone(),
+                points,
+                slow_roll: sr,
+                criticals: Vec::new(),
+            });
+        }
+        let rpm: Vec<f64> = sensors[0].points.iter().map(|p| p.rpm).collect();
+        let dc_coupled = !acq.single_probe
+            && sensors.iter().zip(&acq.probes).all(|(s, p)| {
+                let n = s.points.len().max(1) as f64;
+                let volts = s.points.iter().filter_map(|q| q.dc).sum::<f64>() / n * p.sensitivity;
+                volts.abs() >= DC_COUPLED_V
+            });
+        let mut a = Analysis {
+            sources: self.sources,
+            direction: Direction::of(&rpm),
+            sensors,
+            keyphasor: self.keyphasor,
+            samples: self.samples,
+            notes,
+            operating_rpm: self.settings.operating_rpm,
+            bin_rpm: self.settings.bin_rpm,
+            pair_angles: (!acq.single_probe).then(|| [acq.probes[0].angle, acq.probes[1].angle]),
+            dc_coupled,
+        };
+        find_criticals(&mut a, &self.settings.critical)?;
+        Ok(a)
+    }
+}
+
+/// One row of a 1X table, in SI (the readers' `BodeRow` without its line).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableRow {
+    /// Speed \[rev/min\].
+    pub speed_rpm: f64,
+    /// The sensor that measured it.
+    pub sensor: String,
+    /// Re V \[m\], zero-to-peak.
+    pub re: f64,
+    /// Im V \[m\], zero-to-peak.
+    pub im: f64,
+    /// Standard deviations of re and im \[m\], when the table gives them.
+    pub std: Option<(f64, f64)>,
+}
+
+/// The analysis of a 1X table's `rows` (read from `source`), taken as compensated
+/// (docs/transient.md section 6): each sensor's speed checked, its criticals with their
+/// margins from `settings` (orders and bins do not apply).
+pub fn analyse_table(
+    source: &str,
+    rows: Vec<TableRow>,
+    settings: &Settings,
+) -> Result<Analysis, TransientError> {
+    settings.validate()?;
+    let mut sensors: Vec<Sensor> = Vec::new();
+    for r in rows {
+        let v = C64::new(r.re, r.im);
+        let std = r
+            .std
+            .map_or(f64::NAN, |(a, b)| (0.5 * (a * a + b * b)).sqrt());
+        let point = Point {
+            t: None,
+            rpm: r.speed_rpm,
+            raw: vec![v],
+            comp: vec![v],
+            std: vec![std],
+            dc: None,
+        };
+        match sensors.iter_mut().find(|s| s.name == r.sensor) {
+            Some(s) => s.points.push(point),
+            None => sensors.push(Sensor {
+                name: r.sensor,
+                angle_deg: None,
+                orders: vec![1],
+                points: vec![point],
+                slow_roll: None,
+                criticals: Vec::new(),
+            }),
+        }
+    }
+    if sensors.is_empty() {
+        return Err(TransientError::Within {
+            input: source.to_owned(),
+            source: Box::new(TransientError::TooFew {
+                what: "rows of the 1X table".into(),
+                found: 0,
+                needed: 5,
+            }),
+        });
+    }
+    for s in &sensors {
+        speed_check(s.points.iter().map(|p| p.rpm))
+            .map_err(within(format!("{source}: sensor {:?}", s.name)))?;
+    }
+    let mut notes = vec![format!(
+        "{source}: a 1X table: its vectors are taken as compensated (subtract the slow-roll vector before exporting if the system did not); no cascade or full spectrum without the raw signals"
+    )];
+    if sensors.len() == 1 {
+        notes
+            .push("one sensor: no full spectrum or shaft centreline (they need an XY pair)".into());
+    }
+    let rpm: Vec<f64> = sensors[0].points.iter().map(|p| p.rpm).collect();
+    let mut a = Analysis {
+        sources: vec![source.to_owned()],
+        direction: Direction::of(&rpm),
+        sensors,
+        keyphasor: Vec::new(),
+        samples: Vec::new(),
+        notes,
+        operating_rpm: settings.operating_rpm,
+        bin_rpm: None,
+        pair_angles: None,
+        dc_coupled: false,
+    };
+    find_criticals(&mut a, &settings.critical)?;
+    Ok(a)
+}
+
+/// The criticals of each sensor's compensated 1X, with their margins.
+fn find_criticals(a: &mut Analysis, settings: &CriticalSettings) -> Result<(), TransientError> {
+    for s in &mut a.sensors {
+        let Some(o) = s.orders.iter().position(|&n| n == 1) else {
+            continue;
+        };
+        let rpm: Vec<f64> = s.points.iter().map(|p| p.rpm).collect();
+        let v: Vec<C64> = s.points.iter().map(|p| p.comp[o]).collect();
+        let std: Vec<f64> = s.points.iter().map(|p| p.std[o]).collect();
+        let found = criticals(&rpm, &v, &std, settings)
+            .map_err(within(format!("the critical speeds of {}", s.name)))?;
+        s.criticals = found
+            .into_iter()
+            .map(|c| {
+                let margin = a
+                    .operating_rpm
+                    .map(|(lo, hi)| separation_margin(c.rpm, c.amplification_factor, lo, hi));
+                SensorCritical {
+                    critical: c,
+                    margin,
+                }
+            })
+            .collect();
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn direction_of_a_sweep() {
+        let up: Vec<f64> = (0..100).map(f64::from).collect();
+        let down: Vec<f64> = up.iter().rev().copied().collect();
+        assert_eq!(Direction::of(&up), Direction::RunUp);
+        assert_eq!(Direction::of(&down), Direction::CoastDown);
+        assert_eq!(Direction::of(&[1.0, 5.0, 1.0]), Direction::Mixed);
+        assert_eq!(Direction::RunUp.as_str(), "run_up");
+    }
+
+    #[test]
+    fn a_steady_speed_is_refused_with_its_change() {
+        let e = speed_check([1000.0, 1010.0, 1020.0].into_iter()).unwrap_err();
+        let m = e.to_string();
+        assert!(
+            m.contains("1000.0 to 1020.0 rpm") && m.contains("1.98 %"),
+            "{m}"
+        );
+        assert!(speed_check([1000.0, 1500.0].into_iter()).is_ok());
+    }
+
+    #[test]
+    fn settings_out_of_range_name_the_field() {
+        let s = Settings {
+            bin_rpm: Some(0.0),
+            ..Settings::default()
+        };
+        assert!(s.validate().unwrap_err().to_string().contains("bin_rpm"));
+        let s = Settings {
+            operating_rpm: Some((3600.0, 3000.0)),
+            ..Settings::default()
+        };
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("operating_rpm max"));
+    }
+
+    /// A single-mode 1X curve, A / (1 - r^2 + 2 i zeta r) at r = rpm / nc: the table form
+    /// finds its critical at the closed form's peak, nc / sqrt(1 - 2 zeta^2), and the
+    /// margin API 684 gives from the reported AF.
+    #[test]
+    fn a_table_of_one_mode_gives_its_critical_and_margin() {
+        let (nc, zeta, a0) = (3000.0, 0.05, 1e-5);
+        let rows: Vec<TableRow> = (0..400)
+            .map(|i| {
+                let rpm = 1500.0 + 5.0 * f64::from(i);
+                let r = rpm / nc;
+                let v = C64::new(a0 * r * r, 0.0) / C64::new(1.0 - r * r, 2.0 * zeta * r);
+                TableRow {
+                    speed_rpm: rpm,
+                    sensor: "x".into(),
+                    re: v.re,
+                    im: v.im,
+                    std: None,
+                }
+            })
+            .collect();
+        let settings = Settings {
+            operating_rpm: Some((3600.0, 4000.0)),
+            ..Settings::default()
+        };
+        let a = analyse_table("t.csv", rows, &settings).unwrap();
+        assert_eq!(a.direction, Direction::RunUp);
+        let c = &a.sensors[0].criticals;
+        assert_eq!(c.len(), 1, "{c:?}");
+        // the peak of r^2 / |1 - r^2 + 2 i zeta r| is at r = 1 / sqrt(1 - 2 zeta^2)
+        let peak = nc / (1.0 - 2.0 * zeta * zeta).sqrt();
+        assert!((c[0].critical.rpm / peak - 1.0).abs() < 2e-3, "{c:?}");
+        let af = c[0].critical.amplification_factor.unwrap();
+        assert!((af * 2.0 * zeta - 1.0).abs() < 0.05, "AF {af}");
+        let m = c[0].margin.as_ref().unwrap();
+        let want = separation_margin(c[0].critical.rpm, Some(af), 3600.0, 4000.0);
+        assert_eq!(m, &want);
+        assert!((m.separation_pct - (3600.0 - c[0].critical.rpm) / 36.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn an_empty_table_is_refused_by_name() {
+        let e = analyse_table("t.csv", Vec::new(), &Settings::default()).unwrap_err();
+        assert!(e.to_string().starts_with("t.csv: "), "{e}");
+    }
+}
