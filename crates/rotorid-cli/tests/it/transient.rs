@@ -137,6 +137,36 @@ fn bode_rows(dir: &Path) -> Vec<BodeRow> {
         .collect()
 }
 
+/// The fitted modes of `json` against the rotor's: two, at sqrt(kx / m) and sqrt(kz / m)
+/// (6039.4 and 7396.9 rpm) within 0.5 %, damping ratios ZETA within 20 %, each with a
+/// standard deviation; fitted on the transient response.
+fn check_modes(json: &Value) {
+    let modes = json["modes"].as_array().unwrap();
+    let fit = &json["mode_fit"];
+    assert_eq!(fit["basis"], "transient", "{fit}");
+    assert_eq!(modes.len(), 2, "{modes:?} {fit}");
+    let truth = [KX, KZ].map(|k| (k / M).sqrt() * 60.0 / std::f64::consts::TAU);
+    for (m, rpm) in modes.iter().zip(truth) {
+        let (got, std) = (m["rpm"].as_f64().unwrap(), m["rpm_std"].as_f64().unwrap());
+        let (z, z_std) = (
+            m["damping_ratio"].as_f64().unwrap(),
+            m["damping_ratio_std"].as_f64().unwrap(),
+        );
+        eprintln!(
+            "mode: {got:.2} +- {std:.2} rpm (true {rpm:.2}, {:+.3} %), damping ratio {z:.5} +- {z_std:.5} (true {ZETA}, {:+.2} %), log decrement {}",
+            (got / rpm - 1.0) * 100.0,
+            (z / ZETA - 1.0) * 100.0,
+            m["log_decrement"]
+        );
+        assert!((got / rpm - 1.0).abs() < 0.005, "{m}");
+        assert!((z / ZETA - 1.0).abs() < 0.2, "{m}");
+        assert!(std > 0.0 && z_std > 0.0 && m["log_decrement_std"].as_f64().unwrap() > 0.0);
+        let dec = std::f64::consts::TAU * z / (1.0 - z * z).sqrt();
+        assert!((m["log_decrement"].as_f64().unwrap() - dec).abs() < 1e-12);
+    }
+    eprintln!("mode fit: {fit}");
+}
+
 #[test]
 fn run_up_criticals_amplification_factors_and_margins_match_the_steady_state() {
     let dir = tempfile::tempdir().unwrap();
@@ -244,6 +274,7 @@ fn run_up_criticals_amplification_factors_and_margins_match_the_steady_state() {
             dre.hypot(dim) * 1e6
         );
     }
+    check_modes(&json);
     for f in [
         "report.html",
         "bode.png",

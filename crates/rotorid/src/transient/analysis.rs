@@ -15,11 +15,13 @@ use serde::Serialize;
 
 use super::critical::{criticals, separation_margin, Critical, CriticalSettings, Margin};
 use super::error::TransientError;
+use super::modes::{self, fit_modes, FitBasis, ModeFit, ModeSettings, SensorSeries};
 use super::order::{bin, OrderSettings, Tracked, C64};
 use super::record::track_record;
 use super::slow_roll::{self, SlowRoll, SlowRollSource};
+use super::synchronous::Sweep;
 use crate::acquisition::{Acquisition, KeyphasorReport, RawRecord, Which};
-use crate::model::{rad_per_s_to_rpm, OutOfRange};
+use crate::model::{rad_per_s_to_rpm, rpm_to_rad_per_s, OutOfRange};
 
 /// The least relative speed change (max - min over the mean) of a Bode record \[%\].
 pub const MIN_SPEED_CHANGE_PCT: f64 = 10.0;
@@ -41,6 +43,8 @@ pub struct Settings {
     pub operating_rpm: Option<(f64, f64)>,
     /// How resonances are told from noise.
     pub critical: CriticalSettings,
+    /// The mode fit's settings; `None`: no mode fit.
+    pub modes: Option<ModeSettings>,
 }
 
 impl Default for Settings {
@@ -51,6 +55,7 @@ impl Default for Settings {
             bin_rpm: None,
             operating_rpm: None,
             critical: CriticalSettings::default(),
+            modes: Some(ModeSettings::default()),
         }
     }
 }
@@ -161,6 +166,8 @@ impl Direction {
 pub struct Point {
     /// Mid time of the revolution or bin \[s\] (None from a table).
     pub t: Option<f64>,
+    /// The revolution's or bin's (start, end) \[s\] (None from a table).
+    pub interval: Option<(f64, f64)>,
     /// Speed \[rev/min\].
     pub rpm: f64,
     /// Vectors per order as measured \[m\], zero-to-peak.
@@ -259,6 +266,19 @@ pub struct Analysis {
     /// Whether the probes are DC-coupled (their mean voltage is a gap voltage: at least
     /// [`DC_COUPLED_V`] in magnitude on each).
     pub dc_coupled: bool,
+    /// The modes fitted to the sensors' compensated 1X (None when not asked for, without
+    /// a critical, or when the fit failed: the notes say which).
+    pub modes: Option<Modes>,
+}
+
+/// The mode fit of an analysis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Modes {
+    /// The fit.
+    pub fit: ModeFit,
+    /// The sensors fitted (indices into [`Analysis::sensors`], in the order of
+    /// `fit.model`).
+    pub sensors: Vec<usize>,
 }
 
 impl Analysis {
@@ -482,6 +502,7 @@ impl<'a> RawAnalysis<'a> {
                 .zip(&comp.revolutions)
                 .map(|(r, c)| Point {
                     t: Some(0.5 * (r.t_start + r.t_end)),
+                    interval: Some((r.t_start, r.t_end)),
                     rpm: rad_per_s_to_rpm(c.speed),
                     raw: r.vectors.clone(),
                     comp: c.vectors.clone(),
@@ -517,8 +538,12 @@ impl<'a> RawAnalysis<'a> {
             bin_rpm: self.settings.bin_rpm,
             pair_angles: (!acq.single_probe).then(|| [acq.probes[0].angle, acq.probes[1].angle]),
             dc_coupled,
+            modes: None,
         };
         find_criticals(&mut a, &self.settings.critical)?;
+        if let Some(m) = &self.settings.modes {
+            find_modes(&mut a, m);
+        }
         Ok(a)
     }
 }
@@ -555,6 +580,7 @@ pub fn analyse_table(
             .map_or(f64::NAN, |(a, b)| (0.5 * (a * a + b * b)).sqrt());
         let point = Point {
             t: None,
+            interval: None,
             rpm: r.speed_rpm,
             raw: vec![v],
             comp: vec![v],
@@ -606,8 +632,12 @@ pub fn analyse_table(
         bin_rpm: None,
         pair_angles: None,
         dc_coupled: false,
+        modes: None,
     };
     find_criticals(&mut a, &settings.critical)?;
+    if let Some(m) = &settings.modes {
+        find_modes(&mut a, m);
+    }
     Ok(a)
 }
 
@@ -636,6 +666,124 @@ fn find_criticals(a: &mut Analysis, settings: &CriticalSettings) -> Result<(), T
             .collect();
     }
     Ok(())
+}
+
+/// The modes of the sensors' compensated 1X ([`super::modes`]), started from their
+/// criticals; what was fitted, or why nothing was, in the notes.
+fn find_modes(a: &mut Analysis, settings: &ModeSettings) {
+    let all: Vec<Critical> = a
+        .sensors
+        .iter()
+        .flat_map(|s| s.criticals.iter().map(|c| c.critical.clone()))
+        .collect();
+    let guesses = modes::guesses(&all);
+    if guesses.is_empty() {
+        a.notes
+            .push("no mode fit: no critical speed was found to start it from".into());
+        return;
+    }
+    let one_x = |s: &Sensor| s.orders.iter().position(|&n| n == 1);
+    let Some(first) = a.sensors.iter().position(|s| one_x(s).is_some()) else {
+        return;
+    };
+    let key = |s: &Sensor| -> Vec<(u64, Option<(u64, u64)>)> {
+        s.points
+            .iter()
+            .map(|p| {
+                (
+                    p.rpm.to_bits(),
+                    p.interval.map(|(a, b)| (a.to_bits(), b.to_bits())),
+                )
+            })
+            .collect()
+    };
+    let reference = key(&a.sensors[first]);
+    let (fitted, left): (Vec<usize>, Vec<usize>) = (0..a.sensors.len())
+        .filter(|&k| one_x(&a.sensors[k]).is_some())
+        .partition(|&k| key(&a.sensors[k]) == reference);
+    if !left.is_empty() {
+        let names: Vec<&str> = left.iter().map(|&k| a.sensors[k].name.as_str()).collect();
+        a.notes.push(format!(
+            "mode fit: {} left out (its speeds differ from {}'s; the fit takes sensors measured at the same points)",
+            names.join(", "),
+            a.sensors[first].name
+        ));
+    }
+    let points = &a.sensors[first].points;
+    let speed: Vec<f64> = points.iter().map(|p| rpm_to_rad_per_s(p.rpm)).collect();
+    let sweep = match points
+        .iter()
+        .map(|p| p.interval)
+        .collect::<Option<Vec<_>>>()
+    {
+        Some(intervals) => Sweep::Transient { intervals, speed },
+        None => Sweep::Steady { speed },
+    };
+    let data: Vec<(Vec<C64>, Vec<f64>)> = fitted
+        .iter()
+        .map(|&k| {
+            let s = &a.sensors[k];
+            let o = one_x(s).expect("filtered");
+            (
+                s.points.iter().map(|p| p.comp[o]).collect(),
+                s.points.iter().map(|p| p.std[o]).collect(),
+            )
+        })
+        .collect();
+    let series: Vec<SensorSeries> = data
+        .iter()
+        .map(|(v, s)| SensorSeries { vectors: v, std: s })
+        .collect();
+    match fit_modes(&sweep, &series, &guesses, settings) {
+        Ok(fit) => {
+            let names: Vec<&str> = fitted.iter().map(|&k| a.sensors[k].name.as_str()).collect();
+            let list: Vec<String> = fit
+                .modes
+                .iter()
+                .map(|m| {
+                    format!(
+                        "{:.1} +- {:.1} rpm (damping ratio {:.4} +- {:.4})",
+                        m.rpm, m.rpm_std, m.damping_ratio, m.damping_ratio_std
+                    )
+                })
+                .collect();
+            a.notes.push(format!(
+                "mode fit ({}, {}, {:.0} to {:.0} rpm): {} mode{} chosen by BIC: {}",
+                match fit.basis {
+                    FitBasis::Transient => "the transient response along the measured speed",
+                    FitBasis::SteadyState => "steady-state response: a table has no times, so these modes carry the sweep's bias as the half-power figures do",
+                },
+                names.join(", "),
+                fit.window_rpm.0,
+                fit.window_rpm.1,
+                fit.modes.len(),
+                if fit.modes.len() == 1 { "" } else { "s" },
+                list.join("; ")
+            ));
+            if !fit.converged {
+                a.notes.push(format!(
+                    "mode fit: the iteration stopped after {} trials without converging: its modes are approximate",
+                    fit.iterations
+                ));
+            }
+            if !fit.adequate {
+                a.notes.push(format!(
+                    "mode fit: the residuals show what the model misses (level {:.2} of the noise, whiteness p {}): its standard deviations understate the error (unmodelled modes, speed-dependent modes, a nonlinearity, or a runout the slow roll did not remove)",
+                    fit.noise_ratio,
+                    fit.ljung_box_p
+                        .iter()
+                        .map(|p| format!("{p:.1e}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
+            a.modes = Some(Modes {
+                fit,
+                sensors: fitted,
+            });
+        }
+        Err(e) => a.notes.push(format!("no mode fit: {e}")),
+    }
 }
 
 #[cfg(test)]

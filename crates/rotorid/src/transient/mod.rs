@@ -18,6 +18,7 @@
 //! Pure computation, as the rest of the library: the caller reads the records.
 
 pub mod analysis;
+pub mod angle;
 pub mod critical;
 mod error;
 pub mod modes;

@@ -57,6 +57,8 @@ pub fn track_record(
     let (t, _) = keyphasor_times(stamps);
     let sa = shaft_angle(&t, kp, &acq.keyphasor, which)?;
     let psi: Vec<f64> = sa.phi.iter().map(|p| p - acq.keyphasor.angle).collect();
+    // events timed between samples scatter the phase of single revolutions (super::angle)
+    let psi = super::angle::smooth(&t, &psi);
     let mut out = Vec::with_capacity(probes.len());
     let mut displacement = Vec::with_capacity(probes.len());
     for &k in probes {

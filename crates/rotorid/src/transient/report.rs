@@ -13,6 +13,7 @@ use serde::Serialize;
 
 use super::analysis::{Analysis, Direction};
 use super::critical::Position;
+use super::modes::{Candidate, FitBasis, FittedMode};
 use super::order::C64;
 use super::slow_roll;
 
@@ -148,10 +149,61 @@ pub struct TransientJson {
     pub sensors: Vec<SensorJson>,
     /// The critical speeds, by sensor then speed.
     pub criticals: Vec<CriticalJson>,
+    /// The modes fitted to the 1X vectors, by speed (empty without a fit).
+    pub modes: Vec<FittedMode>,
+    /// How the modes were fitted (None without a fit).
+    pub mode_fit: Option<ModeFitJson>,
     /// Notes.
     pub notes: Vec<String>,
     /// The figures written (file names; empty where none are drawn).
     pub figures: Vec<String>,
+}
+
+/// How the modes in `transient.json` were fitted (docs/transient.md section 6).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeFitJson {
+    /// `transient` (along the measured speed: free of the sweep's bias) or
+    /// `steady_state` (a table without times).
+    pub basis: FitBasis,
+    /// The sensors fitted.
+    pub sensors: Vec<String>,
+    /// The speeds fitted \[rev/min\].
+    pub window_rpm: (f64, f64),
+    /// Real data N and unknowns p.
+    pub data: usize,
+    /// Unknowns p.
+    pub unknowns: usize,
+    /// sqrt(S / (N - p)): the residual's level against the vectors' noise (about 1 when
+    /// the model explains them; null when their stds are unknown).
+    pub noise_ratio: Option<f64>,
+    /// Per sensor, the Ljung-Box p-value of its residuals (the smaller of re and im).
+    pub ljung_box_p: Vec<f64>,
+    /// False when the residuals show what the model misses.
+    pub adequate: bool,
+    /// Whether the iteration converged.
+    pub converged: bool,
+    /// Each number of modes tried, with its BIC (the least chosen).
+    pub candidates: Vec<Candidate>,
+}
+
+/// The mode fit of `a` for `transient.json`.
+pub fn mode_fit_json(a: &Analysis) -> Option<ModeFitJson> {
+    a.modes.as_ref().map(|m| ModeFitJson {
+        basis: m.fit.basis,
+        sensors: m
+            .sensors
+            .iter()
+            .map(|&k| a.sensors[k].name.clone())
+            .collect(),
+        window_rpm: m.fit.window_rpm,
+        data: m.fit.data,
+        unknowns: m.fit.unknowns,
+        noise_ratio: m.fit.noise_ratio.is_finite().then_some(m.fit.noise_ratio),
+        ljung_box_p: m.fit.ljung_box_p.clone(),
+        adequate: m.fit.adequate,
+        converged: m.fit.converged,
+        candidates: m.fit.candidates.clone(),
+    })
 }
 
 /// The critical rows of `a`, by sensor then speed.
@@ -234,6 +286,12 @@ pub fn transient_json(a: &Analysis, figures: &[String]) -> TransientJson {
         operating_rpm: a.operating_rpm,
         sensors,
         criticals: critical_rows(a),
+        modes: a
+            .modes
+            .as_ref()
+            .map(|m| m.fit.modes.clone())
+            .unwrap_or_default(),
+        mode_fit: mode_fit_json(a),
         notes: a.notes.clone(),
         figures: figures.to_vec(),
     }
@@ -329,6 +387,8 @@ mod tests {
             "\"operating_rpm\":null",
             "\"sensors\"",
             "\"criticals\"",
+            "\"modes\"",
+            "\"mode_fit\"",
             "\"notes\"",
             "\"figures\":[]",
         ];

@@ -59,29 +59,77 @@ fn on_common_speeds(a: &Analysis) -> (Vec<f64>, Vec<Vec<(C64, f64)>>) {
             let Some(o) = s.orders.iter().position(|&n| n == 1) else {
                 return vec![(C64::new(f64::NAN, f64::NAN), f64::NAN); rpm.len()];
             };
-            let mut pts: Vec<(f64, C64, f64)> = s
+            let pts: Vec<(f64, C64, f64)> = s
                 .points
                 .iter()
                 .map(|p| (p.rpm, p.comp[o], p.std[o]))
                 .collect();
-            pts.sort_by(|x, y| x.0.total_cmp(&y.0));
-            rpm.iter()
-                .map(|&r| {
-                    let k = pts.partition_point(|p| p.0 < r);
-                    match (pts.get(k), k.checked_sub(1).and_then(|j| pts.get(j))) {
-                        (Some(hi), _) if hi.0 == r => (hi.1, hi.2),
-                        (Some(hi), Some(lo)) => {
-                            let f = (r - lo.0) / (hi.0 - lo.0);
-                            (lo.1 + (hi.1 - lo.1) * f, lo.2 + (hi.2 - lo.2) * f)
-                        }
-                        _ => (C64::new(f64::NAN, f64::NAN), f64::NAN),
-                    }
-                })
-                .collect()
+            interpolate(&rpm, pts)
         })
         .collect();
     (rpm, per)
 }
+
+/// `pts` (speed, vector, std) linearly interpolated on the increasing speeds `rpm` (NaN
+/// outside their range).
+fn interpolate(rpm: &[f64], mut pts: Vec<(f64, C64, f64)>) -> Vec<(C64, f64)> {
+    pts.sort_by(|x, y| x.0.total_cmp(&y.0));
+    rpm.iter()
+        .map(|&r| {
+            let k = pts.partition_point(|p| p.0 < r);
+            match (pts.get(k), k.checked_sub(1).and_then(|j| pts.get(j))) {
+                (Some(hi), _) if hi.0 == r => (hi.1, hi.2),
+                (Some(hi), Some(lo)) => {
+                    let f = (r - lo.0) / (hi.0 - lo.0);
+                    (lo.1 + (hi.1 - lo.1) * f, lo.2 + (hi.2 - lo.2) * f)
+                }
+                _ => (C64::new(f64::NAN, f64::NAN), f64::NAN),
+            }
+        })
+        .collect()
+}
+
+/// The fitted modes' model of each sensor fitted, on the speeds `rpm`, as Bode channels
+/// (black: the data's colours are the sensors').
+fn model_channels(a: &Analysis, rpm: &[f64]) -> Vec<BodeChannel> {
+    let Some(m) = &a.modes else {
+        return Vec::new();
+    };
+    m.sensors
+        .iter()
+        .zip(&m.fit.model)
+        .map(|(&k, model)| {
+            let s = &a.sensors[k];
+            let pts = s.points[m.fit.points.clone()]
+                .iter()
+                .zip(model)
+                .map(|(p, v)| (p.rpm, *v, f64::NAN))
+                .collect();
+            let v = interpolate(rpm, pts);
+            let lag: Vec<f64> = v
+                .iter()
+                .map(|(x, _)| {
+                    if x.norm() > 0.0 {
+                        lag_deg(*x)
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect();
+            BodeChannel {
+                label: format!("{}: fitted modes", s.name),
+                color: MODEL_COLOUR,
+                amplitude: v.iter().map(|(x, _)| UM_PP * x.norm()).collect(),
+                std_amplitude: vec![None; rpm.len()],
+                phase_lag_deg: unwrap_deg(&lag),
+                std_phase_lag_deg: vec![None; rpm.len()],
+            }
+        })
+        .collect()
+}
+
+/// The colour of the fitted model's curves.
+const MODEL_COLOUR: Rgb = Rgb(0, 0, 0);
 
 /// The figures of `a` (module doc).
 pub fn render(a: &Analysis) -> anyhow::Result<Figures> {
@@ -163,6 +211,7 @@ pub fn render(a: &Analysis) -> anyhow::Result<Figures> {
             phase_lag_deg: lag,
         });
     }
+    bode_channels.extend(model_channels(a, &rpm));
     let unit = "\u{b5}m pk-pk".to_string();
     let what = if a.keyphasor.is_empty() {
         "1X table"

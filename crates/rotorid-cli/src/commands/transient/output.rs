@@ -101,6 +101,14 @@ struct FigureView {
     png_base64: String,
 }
 
+/// A fitted mode in the report.
+#[derive(Serialize)]
+struct ModeRow {
+    rpm: String,
+    zeta: String,
+    decrement: String,
+}
+
 fn opt_pm(v: Option<f64>, s: Option<f64>) -> String {
     match (v, s) {
         (Some(v), Some(s)) => pm(v, s),
@@ -141,6 +149,33 @@ pub fn write_report(
             }),
         })
         .collect();
+    let modes: Vec<ModeRow> = json
+        .modes
+        .iter()
+        .map(|m| ModeRow {
+            rpm: pm(m.rpm, m.rpm_std),
+            zeta: pm(m.damping_ratio, m.damping_ratio_std),
+            decrement: opt_pm(m.log_decrement, m.log_decrement_std),
+        })
+        .collect();
+    let mode_fit = json.mode_fit.as_ref().map(|f| {
+        format!(
+            "{} of {} ({} data, {} unknowns), {:.0} to {:.0} rpm; residual level {} of the noise, whiteness p {}: {}{}",
+            match f.basis {
+                rotorid::transient::FitBasis::Transient => "the transient response along the measured speed fitted to the compensated 1X",
+                rotorid::transient::FitBasis::SteadyState => "the steady-state response fitted to the table's 1X (no times: the sweep's bias is in these modes)",
+            },
+            f.sensors.join(", "),
+            f.data,
+            f.unknowns,
+            f.window_rpm.0,
+            f.window_rpm.1,
+            f.noise_ratio.map_or("\u{2014}".into(), |r| format!("{r:.2}")),
+            f.ljung_box_p.iter().map(|p| format!("{p:.2}")).collect::<Vec<_>>().join(", "),
+            if f.adequate { "adequate" } else { "NOT adequate: the residuals show what the model misses, the standard deviations understate the error" },
+            if f.converged { "" } else { "; the iteration did not converge" },
+        )
+    });
     let mut views = Vec::new();
     for (stem, caption) in figures {
         let png = dir.join(format!("{stem}.png"));
@@ -166,6 +201,9 @@ pub fn write_report(
             speed => format!("{:.0} to {:.0} rpm", json.speed_rpm.0, json.speed_rpm.1),
             operating => json.operating_rpm.map(|(a, b)| format!("{a:.0} to {b:.0} rpm")),
             criticals => rows,
+            modes => modes,
+            mode_fit => mode_fit,
+            mode_adequate => json.mode_fit.as_ref().is_none_or(|f| f.adequate),
             sensors => &json.sensors,
             notes => &json.notes,
             figures => views,
