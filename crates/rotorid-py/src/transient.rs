@@ -243,11 +243,7 @@ fn with_angles(
         let phi = match rec.speed {
             Some([phi, _, _]) => phi,
             None => {
-                let profile = match spec {
-                    Some(s) => s.identification()?.speed,
-                    None => None,
-                };
-                let profile = profile.ok_or_else(|| {
+                let profile = spec.and_then(|s| s.speed_profile()).ok_or_else(|| {
                     Error::invalid(format!(
                         "{path}: has no phi column (the shaft angle) and {}: give a record with phi, a scenario whose [speed] profile gives it (as for `rotorid publish --scenario`), or raw records (probe volts and a keyphasor) with a scenario's [acquisition]",
                         match spec {

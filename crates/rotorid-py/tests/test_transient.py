@@ -674,12 +674,13 @@ def _publish_recording(cache: Path) -> Path:
     return path
 
 
-def test_python_publish_recording(cache):
+def test_python_publish_recording(cache, tmp_path):
     """A recording as `rotorid publish` sends it (t, x, z, phi: no keyphasor channel, no
     scenario): the shaft angle phi gives the revolutions (events at phi = 2 pi k), x and z
     are probes at 0 and 90 deg. x and z each have their one critical (the x mode and the z
     mode of the rotor) within 1.5 % of the closed-form steady-state peak of |X| and |Z| and
-    AF within 10 %; a recording without phi and without a scenario is refused naming phi."""
+    AF within 10 %. Without phi, a scenario's [speed] profile gives it (the same criticals);
+    without either, the recording is refused naming phi."""
     rotorid = _rotorid()
     path = _publish_recording(cache)
     tr = rotorid.transient(str(path))
@@ -697,9 +698,24 @@ def test_python_publish_recording(cache):
               f"(REF {rpm / (n2 - n1):.2f})")
         assert abs(c["rpm"] / rpm - 1) <= 0.015
         assert abs(c["amplification_factor"] / (rpm / (n2 - n1)) - 1) <= 0.10
+
+    # without phi, the scenario's [speed] profile gives it (as `rotorid publish --scenario`):
+    # the generator's sweep as a ramp, so the same criticals but for rounding
     with np.load(path) as z:
-        short = {k: z[k][:20000] for k in ("t", "x", "z")}
-    no_phi = path.with_name("publish_no_phi.npz")
-    np.savez(no_phi, **short)
-    with pytest.raises(ValueError, match=r"no phi column"):
+        xz = {k: z[k] for k in ("t", "x", "z")}
+    no_phi = tmp_path / "publish_no_phi.npz"
+    np.savez(no_phi, **xz)
+    with pytest.raises(ValueError, match=r"no phi column.*no scenario was given"):
         rotorid.transient(str(no_phi))
+    speed = tmp_path / "speed.toml"
+    # the machine's scenario, as `rotorid publish --scenario` reads it: its [rotor] (not
+    # used by the transient) and the sweep as a [speed] ramp
+    speed.write_text(f'[rotor]\na = 0.0\nm_u = {rig.ROTOR.mud / 0.1!r}\nd = 0.1\n'
+                     f'alpha_deg = {math.degrees(rig.ROTOR.alpha)!r}\n'
+                     f'[speed]\nkind = "ramp"\nrpm0 = {rig.RUNUP.rpm_from!r}\naccel = {rig.RUNUP.a!r}\n'
+                     f'phi0_deg = {math.degrees(rig.RUNUP.phi0)!r}\n')
+    from_profile = rotorid.transient(str(no_phi), scenario=speed)
+    a, b = tr.criticals, from_profile.criticals
+    assert list(a["sensor"]) == list(b["sensor"])
+    np.testing.assert_allclose(b["rpm"], a["rpm"], rtol=1e-6)
+    np.testing.assert_allclose(b["amplification_factor"], a["amplification_factor"], rtol=1e-4)

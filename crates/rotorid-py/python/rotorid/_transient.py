@@ -186,10 +186,15 @@ def transient(
     """Analyse a run-up or coast-down as ``rotorid transient`` does (docs/transient.md).
 
     Args:
-        records: raw records of one event in time order (a path or a list of paths; any
-            format rotorid reads), with the columns the scenario's ``[acquisition]`` names.
-        scenario: a ``rotorid.Scenario`` or the path of a scenario TOML with an
-            ``[acquisition]`` table (nothing else is needed); required with ``records``.
+        records: the records of one event in time order (a path or a list of paths; any
+            format rotorid reads): raw records (probe volts and a keyphasor) with the
+            columns the scenario's ``[acquisition]`` names, or, with a scenario without
+            ``[acquisition]`` or none, recordings as ``rotorid publish`` sends them (t, x, z
+            [s, m] and phi [rad]: the revolutions are where phi passes 2 pi k; x and z are
+            probes at 0 and 90 deg).
+        scenario: a ``rotorid.Scenario`` or the path of a scenario TOML: its
+            ``[acquisition]`` describes raw records (nothing else is needed); for a
+            recording without phi, its ``[speed]`` profile gives phi.
         vectors: a 1X table instead of records (no scenario): a DataFrame, a dict of
             columns or a CSV path with ``speed_rpm, sensor`` and ``amplitude,
             phase_lag_deg`` or ``re, im``; optional ``unit`` (m, mm, um, mil), ``std`` or
