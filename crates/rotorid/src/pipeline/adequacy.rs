@@ -270,7 +270,7 @@ fn dominant_frequency(r: &[f64], dt: f64) -> f64 {
 
 /// The regularised upper incomplete gamma function Q(a, x) = Gamma(a, x) / Gamma(a)
 /// (series for x < a + 1, continued fraction otherwise; Numerical Recipes 6.2).
-fn gamma_q(a: f64, x: f64) -> f64 {
+pub(crate) fn gamma_q(a: f64, x: f64) -> f64 {
     if x <= 0.0 {
         return 1.0;
     }

@@ -20,7 +20,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod adequacy;
+pub(crate) mod adequacy;
 mod consistency;
 mod diagnostic;
 mod error;

@@ -13,6 +13,12 @@ pub enum TransientError {
     /// The keyphasor or a channel of a raw record cannot be used.
     #[error(transparent)]
     Acquisition(#[from] AcquisitionError),
+    /// The model of a mode fit refused its parameters.
+    #[error(transparent)]
+    Description(#[from] crate::model::description::DescriptionError),
+    /// The model's response cannot be computed (a singular matrix, a growing response).
+    #[error("{0}")]
+    ModelResponse(String),
     /// Two inputs that must have the same length do not.
     #[error("{field} has {len} values but {other} has {expected}")]
     LengthMismatch {

@@ -9,6 +9,9 @@
 //!   its subtraction;
 //! - [`critical`]: resonances of a 1X amplitude curve, half-power speeds, amplification
 //!   factors and separation margins (API 684);
+//! - [`modes`]: a modal model fitted to the transient 1X vectors themselves (the
+//!   [`synchronous`] response of a [`crate::model::description`] along the measured speed),
+//!   free of the sweep's bias, with the number of modes chosen by BIC;
 //! - [`spectrum`]: cascades (waterfalls) of spectra of one probe and full spectra of an
 //!   XY pair against speed.
 //!
@@ -17,15 +20,18 @@
 pub mod analysis;
 pub mod critical;
 mod error;
+pub mod modes;
 pub mod order;
 pub mod record;
 pub mod report;
 pub mod slow_roll;
 pub mod spectrum;
+pub mod synchronous;
 
 pub use analysis::{Analysis, RawAnalysis, SlowRollChoice};
 pub use critical::{criticals, separation_margin, Critical, CriticalSettings, Margin, Position};
 pub use error::TransientError;
+pub use modes::{fit_modes, FitBasis, FittedMode, ModeFit, ModeGuess, ModeSettings};
 pub use order::{track, OrderSettings, Revolution, Tracked};
 pub use record::{track_record, ProbeTrack, RecordTrack};
 pub use report::{transient_json, TransientJson};

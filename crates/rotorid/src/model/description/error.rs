@@ -68,6 +68,9 @@ pub enum DescriptionError {
         /// The rotor's degrees of freedom.
         n: usize,
     },
+    /// A modal model of no mode.
+    #[error("a modal model needs at least one mode: none was given")]
+    NoModes,
     /// The finite-element rotor's own error (an unknown channel, ...).
     #[error(transparent)]
     FiniteElement(#[from] FiniteElementError),

@@ -43,6 +43,10 @@
 //!   of its node's x and y (T^T e_x, T^T e_y when reduced); th the rotor's bearing
 //!   coefficients then unbalances (`bearing<i>.kxx`, ..., `unbalance<j>.alpha`).
 //!
+//! - [`ModalDescription`], n uncoupled modes per unit modal mass (q_j'' + c_j q_j' + k_j q_j
+//!   = Re((w^2 - i w') e^{i phi})), th = (mode0.k, mode0.c, ...) \[1/s^2, 1/s\]: the model
+//!   the transient analysis fits to a run-up's order-tracked vectors.
+//!
 //! The form follows diffsol's `OdeEquations` (a problem states its right-hand side, mass
 //! and parameter sensitivities once, and every solver uses them) and ROSS's
 //! `rotor_assembly` (M, C, K, G assembled from elements and bearings at their nodes'
@@ -50,6 +54,7 @@
 
 mod error;
 mod finite_element;
+mod modal;
 mod two_dof;
 mod vocabulary;
 
@@ -57,6 +62,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 
 pub use error::DescriptionError;
 pub use finite_element::FiniteElementDescription;
+pub use modal::{ModalDescription, Mode};
 pub use two_dof::{TwoDofRotor, UnbalanceCoordinates};
 pub use vocabulary::{Direction, ModelParameter, ParameterKind, Support, ACCEPTED_NAMES};
 

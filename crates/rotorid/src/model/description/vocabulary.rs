@@ -158,13 +158,25 @@ pub enum ModelParameter {
         /// The channel.
         channel: Dof,
     },
+    /// `mode<j>.k`: w_j^2, the stiffness of mode j of a modal model per unit modal mass
+    /// \[1/s^2\] (w_j its undamped natural frequency, rad/s).
+    ModalStiffness {
+        /// The mode's position in the model.
+        mode: usize,
+    },
+    /// `mode<j>.c`: 2 zeta_j w_j, the damping of mode j of a modal model per unit modal mass
+    /// \[1/s\] (zeta_j its damping ratio).
+    ModalDamping {
+        /// The mode's position in the model.
+        mode: usize,
+    },
 }
 
 /// The names [`ModelParameter::from_str`] accepts, in words (for errors).
 pub const ACCEPTED_NAMES: &str = "m, m_x, m_z, cx, kx, cz, kz, a, mud, alpha, cxx, cxz, czx, \
      czz, kxx, kxz, kzx, kzz, mud_cos_alpha, mud_sin_alpha, x0, z0, vx0, vz0, \
      bearing<i>.<kxx|kxy|kyx|kyy|cxx|cxy|cyx|cyy>, unbalance<j>.<mud|alpha>, \
-     initial_state.q[<i>], initial_state.v[<i>], offset.<node>.<x|y|rx|ry>";
+     initial_state.q[<i>], initial_state.v[<i>], offset.<node>.<x|y|rx|ry>, mode<j>.<k|c>";
 
 impl ModelParameter {
     /// Every parameter without an index: the 2-DOF rotor's and the refinement's names, in
@@ -240,6 +252,8 @@ impl ModelParameter {
             StateDisplacement { coordinate } => format!("initial_state.q[{coordinate}]").into(),
             StateVelocity { coordinate } => format!("initial_state.v[{coordinate}]").into(),
             Offset { channel } => format!("offset.{channel}").into(),
+            ModalStiffness { mode } => format!("mode{mode}.k").into(),
+            ModalDamping { mode } => format!("mode{mode}.c").into(),
         }
     }
 
@@ -258,6 +272,8 @@ impl ModelParameter {
             StateDisplacement { .. } => "m or rad",
             StateVelocity { .. } => "m/s or rad/s",
             Offset { channel } => channel.kind.unit(),
+            ModalStiffness { .. } => "1/s^2",
+            ModalDamping { .. } => "1/s",
         }
     }
 
@@ -333,6 +349,12 @@ impl ModelParameter {
                 format!("velocity of coordinate {coordinate} at the first sample").into()
             }
             Offset { channel } => format!("constant offset of channel {channel}").into(),
+            ModalStiffness { mode } => {
+                format!("mode {mode}: w^2, stiffness per unit modal mass").into()
+            }
+            ModalDamping { mode } => {
+                format!("mode {mode}: 2 zeta w, damping per unit modal mass").into()
+            }
         }
     }
 
@@ -361,7 +383,8 @@ impl ModelParameter {
                     Sign::NonNegative
                 }
             }
-            Mud | UnbalanceMud { .. } => Sign::NonNegative,
+            Mud | UnbalanceMud { .. } | ModalDamping { .. } => Sign::NonNegative,
+            ModalStiffness { .. } => Sign::Positive,
             _ => Sign::Any,
         }
     }
@@ -434,6 +457,13 @@ impl FromStr for ModelParameter {
                 return match key {
                     "mud" => Ok(ModelParameter::UnbalanceMud { index }),
                     "alpha" => Ok(ModelParameter::UnbalanceAlpha { index }),
+                    _ => Err(unknown()),
+                };
+            }
+            if let Some(mode) = indexed(head, "mode") {
+                return match key {
+                    "k" => Ok(ModelParameter::ModalStiffness { mode }),
+                    "c" => Ok(ModelParameter::ModalDamping { mode }),
                     _ => Err(unknown()),
                 };
             }
