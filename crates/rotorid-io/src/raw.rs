@@ -138,3 +138,97 @@ pub fn beside(scenario_origin: &str, rel: &str) -> PathBuf {
         .unwrap_or(Path::new("."));
     base.join(rel)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::table::{Channel, TimeAxis};
+
+    fn channel(name: &str, unit: Option<&str>, data: &[f64], axis: Option<TimeAxis>) -> Channel {
+        Channel {
+            name: name.into(),
+            unit: unit.map(Into::into),
+            data: data.to_vec(),
+            axis,
+        }
+    }
+
+    const ROLES: [(&str, &str); 3] = [("t", "time"), ("probe_L", "probe 1"), ("kp", "keyphasor")];
+
+    #[test]
+    fn channels_in_si_by_the_acquisitions_names_and_the_others_as_they_are() {
+        let table = Table {
+            file: "r.tdms".into(),
+            channels: vec![
+                channel("rig/probe_L", Some("mV"), &[1500.0, -250.0], None),
+                channel("kp", Some("V"), &[0.0, -5.0], None),
+                channel("t", Some("ms"), &[0.0, 0.5], None),
+                channel("other", Some("mV"), &[7.0, 8.0], None),
+            ],
+            notes: vec!["an unfinished chunk was not read".into()],
+        };
+        let r = channels(&table, &ROLES, Some("t"), "probe_L").unwrap();
+        let names: Vec<&str> = r.columns.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["probe_L", "kp", "t", "other"]);
+        assert_eq!(r.columns[0].1, [1.5, -0.25]);
+        assert_eq!(r.columns[2].1, [0.0, 0.0005]);
+        assert_eq!(
+            r.columns[3].1,
+            [7.0, 8.0],
+            "a channel without a role is as the file gives it"
+        );
+        assert!(
+            r.notes.is_empty(),
+            "the reader's notes are read()'s: {:?}",
+            r.notes
+        );
+    }
+
+    #[test]
+    fn a_missing_time_comes_from_the_first_probes_axis_with_a_note() {
+        let axis = TimeAxis {
+            start: 1.0,
+            increment: 0.25,
+        };
+        let table = Table {
+            file: "r.uff".into(),
+            channels: vec![channel("probe_L", None, &[0.0; 3], Some(axis))],
+            notes: Vec::new(),
+        };
+        let r = channels(&table, &ROLES, Some("t"), "probe_L").unwrap();
+        assert_eq!(r.columns[1], ("t".to_string(), vec![1.0, 1.25, 1.5]));
+        assert!(
+            r.notes[0].contains("time axis of \"probe_L\""),
+            "{:?}",
+            r.notes
+        );
+        // a sampling rate instead of a time column: no time is made
+        let r = channels(&table, &ROLES, None, "probe_L").unwrap();
+        assert_eq!(r.columns.len(), 1);
+    }
+
+    #[test]
+    fn a_unit_of_another_quantity_names_the_file_channel_and_role() {
+        let table = Table {
+            file: "r.csv".into(),
+            channels: vec![channel("kp", Some("um"), &[0.0], None)],
+            notes: Vec::new(),
+        };
+        let e = channels(&table, &ROLES, Some("t"), "probe_L").unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("r.csv, channel \"kp\" (keyphasor): "),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_scenarios_file_is_beside_it() {
+        assert_eq!(beside("rigs/a.toml", "sr.csv"), Path::new("rigs/sr.csv"));
+        assert_eq!(beside("a.toml", "sr.csv"), Path::new("sr.csv"));
+        assert_eq!(
+            beside("rigs/a.toml", "/data/sr.csv"),
+            Path::new("/data/sr.csv")
+        );
+    }
+}

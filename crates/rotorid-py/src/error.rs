@@ -20,6 +20,13 @@ pub enum Error {
     /// The simulation could not be done.
     #[error(transparent)]
     Simulate(#[from] SimulateError),
+    /// The transient analysis refused an input (the message names the file, the channel
+    /// or sensor, the value and what is allowed).
+    #[error(transparent)]
+    Transient(#[from] rotorid::transient::TransientError),
+    /// A raw record that cannot be read or whose channels have units of another quantity.
+    #[error(transparent)]
+    Raw(Box<rotorid_io::raw::RawError>),
     /// A keyword argument, a column or a file's content that cannot be used; the message
     /// names it and what is allowed.
     #[error("{0}")]
@@ -47,6 +54,12 @@ pub enum Error {
 impl From<rotorid_io::ReadError> for Error {
     fn from(e: rotorid_io::ReadError) -> Self {
         Self::Read(Box::new(e))
+    }
+}
+
+impl From<rotorid_io::raw::RawError> for Error {
+    fn from(e: rotorid_io::raw::RawError) -> Self {
+        Self::Raw(Box::new(e))
     }
 }
 

@@ -10,6 +10,7 @@
 //! - [`options`]: the method and its settings from keyword arguments.
 //! - [`stream`]: identification of a record, or of a live stream of chunks.
 //! - [`balance`]: multi-plane balancing and trial planning from the two CSV tables.
+//! - [`transient`]: run-ups and coast-downs, as `rotorid transient` analyses them.
 //! - [`finite_element`]: a finite-element rotor's scenario joined with its matrices file.
 
 pub mod balance;
@@ -20,6 +21,7 @@ pub mod options;
 pub mod response;
 pub mod scenario;
 pub mod stream;
+pub mod transient;
 
 #[cfg(feature = "python")]
 mod python;

@@ -41,6 +41,13 @@ fn py_err(e: Error) -> PyErr {
             rotorid_io::ReadError::Io { source, .. } => by_kind(source.kind()),
             _ => PyValueError::new_err(text),
         },
+        Error::Raw(r) => match *r {
+            rotorid_io::raw::RawError::Read(r) => match *r {
+                rotorid_io::ReadError::Io { source, .. } => by_kind(source.kind()),
+                _ => PyValueError::new_err(text),
+            },
+            _ => PyValueError::new_err(text),
+        },
         _ => PyValueError::new_err(text),
     }
 }
@@ -832,6 +839,87 @@ fn balance(
     .map_err(py_err)
 }
 
+/// A run-up or coast-down analysed as `rotorid transient` analyses it
+/// (`crate::transient`): `(transient.json text, {bode.csv column: array or list}, [(file,
+/// note)])`. `scenario` is a `Scenario` or a path; `vectors` the CSV text of a 1X table
+/// (`vectors_name` names it in messages); `slow_roll_kind` one of `default`, `auto`,
+/// `none`, `file` (`slow_roll_file`) or `range` (`slow_roll_range`, rev/min).
+#[pyfunction]
+#[pyo3(signature = (records, *, scenario=None, vectors=None, vectors_name=None, amplitude="pk",
+    unit=None, slow_roll_kind="default", slow_roll_file=None, slow_roll_range=None, orders=None,
+    operating_rpm=None, bin_rpm=None))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn transient<'py>(
+    py: Python<'py>,
+    records: Vec<String>,
+    scenario: Option<&Bound<'py, PyAny>>,
+    vectors: Option<String>,
+    vectors_name: Option<String>,
+    amplitude: &str,
+    unit: Option<String>,
+    slow_roll_kind: &str,
+    slow_roll_file: Option<String>,
+    slow_roll_range: Option<(f64, f64)>,
+    orders: Option<Vec<u32>>,
+    operating_rpm: Option<(f64, f64)>,
+    bin_rpm: Option<f64>,
+) -> PyResult<(String, Bound<'py, PyDict>, Vec<(String, String)>)> {
+    use crate::transient::{Request, SlowRollKw};
+    let slow_roll = match (slow_roll_kind, slow_roll_file, slow_roll_range) {
+        ("default", None, None) => SlowRollKw::Default,
+        ("auto", None, None) => SlowRollKw::Auto,
+        ("none", None, None) => SlowRollKw::None,
+        ("file", Some(f), None) => SlowRollKw::File(f),
+        ("range", None, Some((a, b))) => SlowRollKw::Range(a, b),
+        (k, _, _) => {
+            return Err(PyValueError::new_err(format!(
+                "slow_roll_kind={k:?}: expected default, auto, none, file (with slow_roll_file) or range (with slow_roll_range)"
+            )))
+        }
+    };
+    let spec = match scenario {
+        None => None,
+        Some(s) => match s.cast::<PyScenario>() {
+            Ok(sc) => Some(sc.get().inner.spec().clone()),
+            Err(_) => {
+                let path: std::path::PathBuf = s.extract()?;
+                let sc = Scenario::from_toml_file(&path.to_string_lossy()).map_err(py_err)?;
+                Some(sc.spec().clone())
+            }
+        },
+    };
+    let request = Request {
+        records,
+        vectors: vectors.map(|text| (vectors_name.unwrap_or_else(|| "vectors".into()), text)),
+        amplitude: amplitude.to_owned(),
+        unit,
+        slow_roll,
+        orders,
+        operating_rpm,
+        bin_rpm,
+    };
+    let out = py
+        .detach(|| crate::transient::transient(spec.as_ref(), &request))
+        .map_err(py_err)?;
+    let b = out.bode;
+    let d = PyDict::new(py);
+    d.set_item("speed_rpm", PyArray1::from_vec(py, b.speed_rpm))?;
+    d.set_item("sensor", b.sensor)?;
+    d.set_item("order", PyArray1::from_vec(py, b.order))?;
+    for (name, c) in [
+        ("amplitude", b.amplitude),
+        ("phase_lag_deg", b.phase_lag_deg),
+        ("re", b.re),
+        ("im", b.im),
+        ("std", b.std),
+        ("raw_re", b.raw_re),
+        ("raw_im", b.raw_im),
+    ] {
+        d.set_item(name, PyArray1::from_vec(py, c))?;
+    }
+    Ok((out.json, d, out.read_notes))
+}
+
 /// The extension module.
 #[pymodule]
 #[pyo3(name = "_rotorid")]
@@ -844,6 +932,7 @@ fn rotorid_extension(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBlocks>()?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;
     m.add_function(wrap_pyfunction!(balance, m)?)?;
+    m.add_function(wrap_pyfunction!(transient, m)?)?;
     m.add_function(wrap_pyfunction!(read_fe_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(load_finite_element, m)?)?;
     m.add_function(wrap_pyfunction!(identify_finite_element, m)?)?;

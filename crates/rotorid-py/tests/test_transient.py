@@ -486,3 +486,236 @@ def test_no_keyphasor_pulse_fails_naming_the_column(cli, cache, tmp_path):
     assert re.search(r"\bkp\b", p.stderr), f"the error does not name the keyphasor column kp:\n{p.stderr}"
     written = sorted(x.name for x in out.iterdir()) if out.exists() else []
     assert not written, f"files written despite the error: {written}"
+
+
+# --------------------------------------------------------------------------- the Python package (rotorid.transient)
+#
+# The same analysis from Python: the result equals the command's transient.json and bode.csv
+# on the same input, bit for bit (figures aside: Python draws none); a 1X table from a
+# DataFrame; a recording as `rotorid publish` sends it (t, x, z, phi); errors as the
+# command's. Skipped where the rotorid package is not installed (pytest --noconftest).
+
+
+def _rotorid():
+    return pytest.importorskip("rotorid")
+
+
+def _same_as_cli(tr, out: Output) -> None:
+    """tr (a rotorid.Transient) against the command's files: transient.json equal but for
+    the figures; every bode.csv field equal as parsed (floats bit for bit, std empty = NaN)."""
+    want = dict(out.json)
+    assert tr.to_dict()["figures"] == []
+    want["figures"] = []
+    assert tr.to_dict() == want
+    assert json.loads(tr.json) == want
+    df = tr.bode
+    assert list(df.columns) == BODE_COLUMNS == out.header
+    assert len(df) == len(out.rows)
+    for i, c in enumerate(BODE_COLUMNS):
+        got = df[c].tolist()
+        cells = [r[i] for r in out.rows]
+        if c == "sensor":
+            assert got == cells, c
+        elif c == "order":
+            assert got == [int(v) for v in cells], c
+        else:
+            want_c = np.array([float(v) if v != "" else np.nan for v in cells])
+            np.testing.assert_array_equal(np.asarray(got, dtype=float), want_c, err_msg=c)
+
+
+def test_python_runup_equals_the_cli(runup, cache):
+    """rotorid.transient on the run-up record and scenario: transient.json and bode.csv of
+    `rotorid transient` with the same arguments, exactly."""
+    rotorid = _rotorid()
+    rec = str(_record(cache, "runup"))
+    tr = rotorid.transient(rec, scenario=cache / "scenario.toml", operating_rpm=RUNUP_OPERATING)
+    _same_as_cli(tr, runup)
+    assert tr.direction == "run_up"
+    assert set(tr.sensors) == set(PROBES)
+
+
+def test_python_runup_criticals_match_the_steady_state(cache, ref):
+    """The criticals DataFrame: per probe its two criticals within 1.5 % of REF's
+    steady-state peak speed and AF within 10 % (the Done-when checks, on the DataFrame),
+    margins as API 684 gives them from the reported AF; a rotorid.Scenario works as the
+    path does."""
+    rotorid = _rotorid()
+    rec = str(_record(cache, "runup"))
+    sc = rotorid.Scenario.from_toml(cache / "scenario.toml")
+    tr = rotorid.transient([rec], scenario=sc, operating_rpm=RUNUP_OPERATING)
+    df = tr.criticals
+    assert CRITICAL_FIELDS <= set(df.columns)
+    assert (df["order"] == 1).all() and (df["unit"] == "m").all()
+    for probe in PROBES:
+        got = df[df["sensor"] == probe].sort_values("rpm")
+        want = ref["peaks"][probe]
+        assert len(got) == 2, got
+        for (_, k), w in zip(got.iterrows(), want):
+            assert abs(k["rpm"] / w.rpm - 1) <= 0.015, (probe, k["rpm"], w.rpm)
+            assert abs(k["amplification_factor"] / w.af - 1) <= 0.10, (probe, k["amplification_factor"], w.af)
+            actual, required, ok = rig.api684_margin(k["rpm"], k["amplification_factor"], *RUNUP_OPERATING)
+            assert k["separation_margin_pct"] == pytest.approx(actual, abs=1e-9)
+            assert k["required_margin_pct"] == pytest.approx(required, abs=1e-9)
+            assert bool(k["margin_ok"]) is ok
+
+
+def test_python_options_equal_the_cli(cli, cache, tmp_path):
+    """slow_roll as a range, orders 1,2,3 and bins: the command's output with the same
+    options, exactly; slow_roll="auto" names its range in the notes."""
+    rotorid = _rotorid()
+    rec = _record(cache, "runup")
+    out = tmp_path / "out"
+    p = _transient(cli, rec, cache / "scenario.toml", out, "--slow-roll", "480:700", "--orders", "1,2,3",
+                   "--bin-rpm", "20")
+    tr = rotorid.transient(str(rec), scenario=str(cache / "scenario.toml"), slow_roll=(480, 700),
+                           orders=[1, 2, 3], bin_rpm=20)
+    _same_as_cli(tr, Output(p, out))
+    auto = rotorid.transient(str(rec), scenario=cache / "scenario.toml", slow_roll="auto", orders=[1])
+    assert any("picked automatically" in n for n in auto.notes), auto.notes
+
+
+def _steady_table(ref: dict, rpm: np.ndarray, noise: float, seed: int) -> "pd.DataFrame":
+    """A 1X table as a machinery-protection system exports it: each probe's steady-state
+    1X (REF) at the speeds rpm, amplitude in um peak-to-peak and phase lag in deg, with a
+    relative scatter `noise` of each reading (seeded)."""
+    import pandas as pd
+
+    rng = np.random.default_rng(seed)
+    rows = []
+    for probe in PROBES:
+        v = ref["vector"][probe](rpm) * (1 + noise * rng.standard_normal(len(rpm)))
+        rows.append(pd.DataFrame({
+            "speed_rpm": rpm, "sensor": probe, "amplitude": 2e6 * np.abs(v),
+            "phase_lag_deg": np.mod(-np.degrees(np.angle(v)), 360.0), "unit": "um",
+        }))
+    return pd.concat(rows, ignore_index=True)
+
+
+def test_python_table_from_a_dataframe(cli, ref, tmp_path):
+    """A 1X table from a DataFrame (pk-pk, um, 2 % scatter): per probe its two criticals
+    within 0.5 % of REF's peak and AF within 10 %; the same as the command on the table
+    written to CSV, and as the Python call on that CSV path (but the table's name)."""
+    rotorid = _rotorid()
+    df = _steady_table(ref, np.arange(3000.0, 9000.0, 4.0), 0.02, 5)
+    tr = rotorid.transient(vectors=df, amplitude="pk-pk", operating_rpm=RUNUP_OPERATING)
+    for probe in PROBES:
+        got = tr.criticals[tr.criticals["sensor"] == probe].sort_values("rpm")
+        assert len(got) == 2, got
+        for (_, k), w in zip(got.iterrows(), ref["peaks"][probe]):
+            assert abs(k["rpm"] / w.rpm - 1) <= 0.005, (probe, k["rpm"], w.rpm)
+            assert abs(k["amplification_factor"] / w.af - 1) <= 0.10, (probe, k["amplification_factor"], w.af)
+    path = tmp_path / "table.csv"
+    df.to_csv(path, index=False)
+    out = tmp_path / "out"
+    p = subprocess.run([cli, "transient", "--vectors", str(path), "--amplitude", "pk-pk", "--operating-rpm",
+                        "%g:%g" % RUNUP_OPERATING, "--out", str(out)], capture_output=True, text=True, timeout=300)
+    from_path = rotorid.transient(vectors=str(path), amplitude="pk-pk", operating_rpm=RUNUP_OPERATING)
+    _same_as_cli(from_path, Output(p, out))
+    a, b = tr.to_dict(), from_path.to_dict()
+    assert a["sources"] == ["vectors_df"] and b["sources"] == [str(path)]
+    for d in (a, b):
+        d.pop("sources"), d.pop("notes")
+    assert a == b
+    # a dict of columns (re, im in m) is a table too
+    v = ref["vector"]["probe_L"](np.arange(3000.0, 9000.0, 4.0))
+    cols = {"speed_rpm": np.arange(3000.0, 9000.0, 4.0), "sensor": ["probe_L"] * len(v), "re": v.real, "im": v.imag}
+    one = rotorid.transient(vectors=cols, unit="m")
+    assert len(one.criticals) == 2 and any("one sensor" in n for n in one.notes)
+
+
+def test_python_errors_name_the_input(cache, tmp_path):
+    """Bad input raises with the command's message: the file, line and field, the value and
+    what is allowed; nothing is returned."""
+    rotorid = _rotorid()
+    import pandas as pd
+
+    dup = pd.DataFrame({"speed_rpm": [1000.0, 1100.0, 1000.0], "sensor": ["a", "a", "a"],
+                        "re": [1.0, 1.0, 2.0], "im": [0.0, 0.0, 0.0], "unit": ["um"] * 3})
+    with pytest.raises(ValueError, match=r"vectors_df line 4: sensor \"a\" at 1000 rpm is also on line 2"):
+        rotorid.transient(vectors=dup)
+    bad_unit = dup.assign(speed_rpm=[1000.0, 1100.0, 1200.0], unit=["um", "furlong", "um"])
+    with pytest.raises(ValueError, match=r"vectors_df line 3.*furlong.*(m, mm, um, mil|um)"):
+        rotorid.transient(vectors=bad_unit)
+    steady = dup.assign(speed_rpm=[1000.0 + i for i in range(3)])
+    with pytest.raises(ValueError, match=r"changes only from 1000.0 to 1002.0 rpm"):
+        rotorid.transient(vectors=pd.concat([steady] * 1, ignore_index=True))
+    with pytest.raises(ValueError, match=r"nokp.csv: order tracking: .*keyphasor column \"kp\" holds no pulse"):
+        rotorid.transient(str(_record(cache, "nokp")), scenario=cache / "scenario.toml")
+    with pytest.raises(FileNotFoundError, match=r"missing.csv"):
+        rotorid.transient(str(tmp_path / "missing.csv"), scenario=cache / "scenario.toml")
+    with pytest.raises(ValueError, match=r"bin_rpm = -1 is out of range"):
+        rotorid.transient(str(_record(cache, "nokp")), scenario=cache / "scenario.toml", bin_rpm=-1)
+    with pytest.raises(ValueError, match=r"operating_rpm max"):
+        rotorid.transient(vectors=dup, operating_rpm=(3600, 3000))
+    with pytest.raises(ValueError, match=r"slow_roll, bin_rpm and orders apply to raw records only"):
+        rotorid.transient(vectors=dup, orders=[1])
+    with pytest.raises(ValueError, match=r"slow_roll='a:b'"):
+        rotorid.transient(vectors=dup, slow_roll="a:b")
+
+
+# ------------------------------------------------------------------ a recording as `rotorid publish` sends it
+
+
+def _publish_recording(cache: Path) -> Path:
+    """The run-up's motion as `rotorid publish` reads a recording (docs/fleet.md): t, x, z
+    [s, m] and phi, phi_dot, phi_ddot [rad, rad/s, rad/s^2] in an NPZ, x and z with the
+    rig's noise (its 5 mV over 7874 V/m, seeded); cached with the records."""
+    path = cache / "publish_runup.npz"
+    if not path.exists():
+        rec = rig.make_record(rig.ROTOR, rig.RIG, rig.RUNUP, rig.SEEDS["runup"])
+        rng = np.random.default_rng(11)
+        sd = rig.RIG.noise_v / rig.RIG.probes[0].sensitivity
+        tmp = cache / f".publish_runup.{os.getpid()}.npz"
+        with open(tmp, "wb") as f:
+            np.savez(f, t=rec.t, x=rec.x + sd * rng.standard_normal(len(rec.t)),
+                     z=rec.z + sd * rng.standard_normal(len(rec.t)), phi=rec.phi, phi_dot=rec.w,
+                     phi_ddot=np.full(len(rec.t), rig.RUNUP.a))
+        os.replace(tmp, path)
+    return path
+
+
+def test_python_publish_recording(cache, tmp_path):
+    """A recording as `rotorid publish` sends it (t, x, z, phi: no keyphasor channel, no
+    scenario): the shaft angle phi gives the revolutions (events at phi = 2 pi k), x and z
+    are probes at 0 and 90 deg. x and z each have their one critical (the x mode and the z
+    mode of the rotor) within 1.5 % of the closed-form steady-state peak of |X| and |Z| and
+    AF within 10 %. Without phi, a scenario's [speed] profile gives it (the same criticals);
+    without either, the recording is refused naming phi."""
+    rotorid = _rotorid()
+    path = _publish_recording(cache)
+    tr = rotorid.transient(str(path))
+    assert tr.sensors == ["x", "z"] and tr.direction == "run_up"
+    assert any("phi" in n for n in tr.notes), tr.notes
+    for k, name in enumerate(["x", "z"]):
+        peaks = rig.peaks_of(lambda q, _k=k: np.abs(rig.steady_state_xz(rig.ROTOR, q * rig.RPM)[_k]),
+                             rig.RPM_SLOW, rig.RPM_TOP)
+        assert len(peaks) == 1, peaks
+        rpm, _amp, n1, n2 = peaks[0]
+        got = tr.criticals[tr.criticals["sensor"] == name]
+        assert len(got) == 1, got
+        c = got.iloc[0]
+        print(f"publish recording {name}: {c['rpm']:.1f} rpm (REF {rpm:.1f}), AF {c['amplification_factor']:.2f} "
+              f"(REF {rpm / (n2 - n1):.2f})")
+        assert abs(c["rpm"] / rpm - 1) <= 0.015
+        assert abs(c["amplification_factor"] / (rpm / (n2 - n1)) - 1) <= 0.10
+
+    # without phi, the scenario's [speed] profile gives it (as `rotorid publish --scenario`):
+    # the generator's sweep as a ramp, so the same criticals but for rounding
+    with np.load(path) as z:
+        xz = {k: z[k] for k in ("t", "x", "z")}
+    no_phi = tmp_path / "publish_no_phi.npz"
+    np.savez(no_phi, **xz)
+    with pytest.raises(ValueError, match=r"no phi column.*no scenario was given"):
+        rotorid.transient(str(no_phi))
+    speed = tmp_path / "speed.toml"
+    # the machine's scenario, as `rotorid publish --scenario` reads it: its [rotor] (not
+    # used by the transient) and the sweep as a [speed] ramp
+    speed.write_text(f'[rotor]\na = 0.0\nm_u = {rig.ROTOR.mud / 0.1!r}\nd = 0.1\n'
+                     f'alpha_deg = {math.degrees(rig.ROTOR.alpha)!r}\n'
+                     f'[speed]\nkind = "ramp"\nrpm0 = {rig.RUNUP.rpm_from!r}\naccel = {rig.RUNUP.a!r}\n'
+                     f'phi0_deg = {math.degrees(rig.RUNUP.phi0)!r}\n')
+    from_profile = rotorid.transient(str(no_phi), scenario=speed)
+    a, b = tr.criticals, from_profile.criticals
+    assert list(a["sensor"]) == list(b["sensor"])
+    np.testing.assert_allclose(b["rpm"], a["rpm"], rtol=1e-6)
+    np.testing.assert_allclose(b["amplification_factor"], a["amplification_factor"], rtol=1e-4)

@@ -32,6 +32,11 @@ Balancing (influence coefficients of many planes, sensors and speeds)::
     b = rotorid.balance(vectors_df, masses_df, current="asfound", holes={"disk1": 12})
     b.corrections                                      # mass_kg, angle_deg and their std
     b.residual, b.influence, b.split                   # DataFrames; b.to_dict() == balance.json
+
+Run-ups and coast-downs (``docs/transient.md``), as ``rotorid transient`` analyses them::
+
+    tr = rotorid.transient("runup.csv", scenario="rig.toml", operating_rpm=(3000, 3600))
+    tr.bode, tr.criticals                              # DataFrames; tr.to_dict() == transient.json
 """
 
 from __future__ import annotations
@@ -55,6 +60,7 @@ from ._rotorid import (
 )
 from ._balance import Balance, TrialPlan, balance, plan_trials
 from ._result import Identification
+from ._transient import Transient, transient
 
 __all__ = [
     "ESTIMATE_COLUMNS",
@@ -68,6 +74,7 @@ __all__ = [
     "Scenario",
     "Session",
     "TrialPlan",
+    "Transient",
     "balance",
     "identify",
     "load_finite_element",
@@ -76,6 +83,7 @@ __all__ = [
     "read",
     "read_blocks",
     "simulate",
+    "transient",
 ]
 
 __version__ = "0.1.0"

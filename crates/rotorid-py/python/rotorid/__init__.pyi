@@ -12,6 +12,8 @@ from ._balance import TrialPlan as TrialPlan
 from ._balance import balance as balance
 from ._balance import plan_trials as plan_trials
 from ._result import Identification as Identification
+from ._transient import Transient as Transient
+from ._transient import transient as transient
 
 __all__ = [
     "ESTIMATE_COLUMNS",
@@ -25,6 +27,7 @@ __all__ = [
     "Scenario",
     "Session",
     "TrialPlan",
+    "Transient",
     "balance",
     "identify",
     "load_finite_element",
@@ -33,6 +36,7 @@ __all__ = [
     "read",
     "read_blocks",
     "simulate",
+    "transient",
 ]
 
 __version__: str

@@ -1,12 +1,13 @@
 """The extension module (Rust). Use the package ``rotorid``; these are its building blocks."""
 
+import os
 from typing import Any, final
 
 import numpy as np
 
 from . import Scenario as Scenario
 
-__all__ = ["ESTIMATE_COLUMNS", "ESTIMATE_COLUMNS_BY_MODEL", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "identify_finite_element", "load_finite_element", "read", "read_blocks", "read_fe_matrices", "simulate"]
+__all__ = ["ESTIMATE_COLUMNS", "ESTIMATE_COLUMNS_BY_MODEL", "METHODS", "MODELS", "UNKNOWNS", "Blocks", "Scenario", "Session", "balance", "identify", "identify_finite_element", "load_finite_element", "read", "read_blocks", "read_fe_matrices", "simulate", "transient"]
 
 METHODS: list[str]
 MODELS: list[str]
@@ -92,6 +93,23 @@ def balance(
     plan: float | None = None,
 ) -> str:
     """balance.json (or, with plan=fraction, the trial plan) as JSON text."""
+
+def transient(
+    records: list[str],
+    *,
+    scenario: Scenario | str | os.PathLike[str] | None = None,
+    vectors: str | None = None,
+    vectors_name: str | None = None,
+    amplitude: str = "pk",
+    unit: str | None = None,
+    slow_roll_kind: str = "default",
+    slow_roll_file: str | None = None,
+    slow_roll_range: tuple[float, float] | None = None,
+    orders: list[int] | None = None,
+    operating_rpm: tuple[float, float] | None = None,
+    bin_rpm: float | None = None,
+) -> tuple[str, dict[str, Any], list[tuple[str, str]]]:
+    """(transient.json text, bode.csv columns, [(file, reader note)])."""
 
 @final
 class Session:

@@ -8,7 +8,9 @@
 //!
 //! Raw records: [`RawAnalysis::new`], then [`RawAnalysis::add_record`] for each record of
 //! the event in time order (tracked at once, so a caller can drop each record's samples
-//! before reading the next), then [`RawAnalysis::finish`] with the slow-roll choice. A
+//! before reading the next), then [`RawAnalysis::finish`] with the slow-roll choice.
+//! Records whose shaft angle is known per sample (a recording as `rotorid publish` sends
+//! it, `t, x, z, phi`): [`RawAnalysis::with_angles`] and [`RawAnalysis::add_angles`]. A
 //! 1X table: [`analyse_table`]. Pure computation: no file is read here.
 
 use serde::Serialize;
@@ -16,11 +18,11 @@ use serde::Serialize;
 use super::critical::{criticals, separation_margin, Critical, CriticalSettings, Margin};
 use super::error::TransientError;
 use super::modes::{self, fit_modes, FitBasis, ModeFit, ModeSettings, SensorSeries};
-use super::order::{bin, OrderSettings, Tracked, C64};
+use super::order::{bin, track, OrderSettings, Tracked, C64};
 use super::record::track_record;
 use super::slow_roll::{self, SlowRoll, SlowRollSource};
 use super::synchronous::Sweep;
-use crate::acquisition::{Acquisition, KeyphasorReport, RawRecord, Which};
+use crate::acquisition::{Acquisition, KeyphasorReport, Probe, RawRecord, Which};
 use crate::model::{rad_per_s_to_rpm, rpm_to_rad_per_s, OutOfRange};
 
 /// The least relative speed change (max - min over the mean) of a Bode record \[%\].
@@ -298,6 +300,22 @@ fn min_max(v: impl Iterator<Item = f64>) -> (f64, f64) {
     })
 }
 
+/// The speed d phi / dt \[rad/s\] at each sample: central differences inside, one-sided at
+/// the ends (0 for fewer than two samples).
+fn angular_speed(t: &[f64], phi: &[f64]) -> Vec<f64> {
+    let n = t.len().min(phi.len());
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n.saturating_sub(1)));
+            if b > a {
+                (phi[b] - phi[a]) / (t[b] - t[a])
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
 /// `Ok` when the speeds `rpm` change by at least [`MIN_SPEED_CHANGE_PCT`] of their mean.
 pub fn speed_check(rpm: impl Iterator<Item = f64>) -> Result<(), TransientError> {
     let (mut lo, mut hi, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0usize);
@@ -329,10 +347,13 @@ fn within(input: impl Into<String>) -> impl FnOnce(TransientError) -> TransientE
     }
 }
 
-/// A run-up or coast-down's raw records, order-tracked as they are added (module doc).
+/// A run-up or coast-down's records, order-tracked as they are added (module doc).
 #[derive(Debug, Clone)]
 pub struct RawAnalysis<'a> {
-    acq: &'a Acquisition,
+    /// The acquisition of raw records (None: records whose shaft angle is given).
+    acq: Option<&'a Acquisition>,
+    /// The probes tracked (one or two), in the order of the sensors.
+    probes: Vec<Probe>,
     settings: Settings,
     sources: Vec<String>,
     tracked: Vec<Tracked>,
@@ -341,11 +362,18 @@ pub struct RawAnalysis<'a> {
 }
 
 impl<'a> RawAnalysis<'a> {
-    /// An analysis of records described by `acq` (one or two probes), `settings` checked.
+    /// An analysis of raw records described by `acq` (one or two probes), `settings`
+    /// checked; records are added by [`RawAnalysis::add_record`].
     pub fn new(acq: &'a Acquisition, settings: Settings) -> Result<Self, TransientError> {
         settings.validate()?;
+        let probes = if acq.single_probe {
+            vec![acq.probes[0].clone()]
+        } else {
+            acq.probes.to_vec()
+        };
         Ok(Self {
-            acq,
+            acq: Some(acq),
+            probes,
             settings,
             sources: Vec::new(),
             tracked: Vec::new(),
@@ -354,39 +382,134 @@ impl<'a> RawAnalysis<'a> {
         })
     }
 
-    /// The probes of the acquisition to track: both, or the one of a single-probe scenario.
-    fn probes(&self) -> &'static [usize] {
-        if self.acq.single_probe {
+    /// An analysis of records whose shaft angle is known per sample (an encoder, a
+    /// simulation, a recording as `rotorid publish` sends it: `t, x, z, phi`), the
+    /// displacement of each of `probes` given in m (their sensitivities are not used),
+    /// `settings` checked; records are added by [`RawAnalysis::add_angles`]. The x and z
+    /// of a response recording are probes at 0 and 90 deg: [`RawAnalysis::xz_probes`].
+    pub fn with_angles(probes: Vec<Probe>, settings: Settings) -> Result<Self, TransientError> {
+        settings.validate()?;
+        if !(1..=2).contains(&probes.len()) {
+            return Err(TransientError::TooFew {
+                what: "probes (one, or an XY pair)".into(),
+                found: probes.len(),
+                needed: 1,
+            });
+        }
+        Ok(Self {
+            acq: None,
+            probes,
+            settings,
+            sources: Vec::new(),
+            tracked: Vec::new(),
+            keyphasor: Vec::new(),
+            samples: Vec::new(),
+        })
+    }
+
+    /// The x and z of a response recording (`t, x, z[, phi, ...]`, docs/fleet.md) as
+    /// probes: `x` at 0 deg (horizontal), `z` at 90 deg (vertical), in m.
+    pub fn xz_probes() -> Vec<Probe> {
+        [("x", 0.0), ("z", std::f64::consts::FRAC_PI_2)]
+            .map(|(column, angle)| Probe {
+                column: column.into(),
+                angle,
+                sensitivity: 1.0,
+            })
+            .to_vec()
+    }
+
+    /// The indices of the acquisition's probes tracked: both, or the one of a
+    /// single-probe scenario.
+    fn indices(&self) -> &'static [usize] {
+        if self.probes.len() == 1 {
             &[0]
         } else {
             &[0, 1]
         }
     }
 
-    /// Order-track the next record of the event, `source` naming it (errors start with
-    /// it: `runup.csv: order tracking: ...`).
+    fn push(&mut self, source: &str, tracked: Vec<Tracked>, samples: Samples) {
+        for (k, t) in tracked.into_iter().enumerate() {
+            match self.tracked.get_mut(k) {
+                Some(all) => all.revolutions.extend(t.revolutions),
+                None => self.tracked.push(t),
+            }
+        }
+        self.sources.push(source.to_owned());
+        self.samples.push(samples);
+    }
+
+    /// Order-track the next raw record of the event, `source` naming it (errors start
+    /// with it: `runup.csv: order tracking: ...`).
     pub fn add_record(&mut self, source: &str, raw: &RawRecord) -> Result<(), TransientError> {
+        let acq = self.acq.ok_or_else(|| TransientError::Unusable {
+            input: source.to_owned(),
+            reason: "a raw record (probe volts and a keyphasor) needs the scenario's [acquisition]; this analysis takes records with a shaft angle",
+        })?;
         let r = track_record(
             raw,
-            self.acq,
-            self.probes(),
+            acq,
+            self.indices(),
             &self.settings.order,
             Which::Running,
         )
         .map_err(within(format!("{source}: order tracking")))?;
-        for (k, p) in r.probes.into_iter().enumerate() {
-            match self.tracked.get_mut(k) {
-                Some(t) => t.revolutions.extend(p.tracked.revolutions),
-                None => self.tracked.push(p.tracked),
-            }
-        }
-        self.sources.push(source.to_owned());
         self.keyphasor.push(r.keyphasor);
-        self.samples.push(Samples {
-            t: r.t,
-            omega: r.omega,
-            displacement: r.displacement,
-        });
+        let tracked = r.probes.into_iter().map(|p| p.tracked).collect();
+        self.push(
+            source,
+            tracked,
+            Samples {
+                t: r.t,
+                omega: r.omega,
+                displacement: r.displacement,
+            },
+        );
+        Ok(())
+    }
+
+    /// Order-track the next record of the event whose shaft angle `phi` \[rad\] is known
+    /// at each time `t` \[s\] (increasing; the keyphasor events are where phi passes a
+    /// multiple of 2 pi, so the phase lags are measured from phi = 0 mod 2 pi), with the
+    /// displacement \[m\] of each probe of [`RawAnalysis::with_angles`]; `source` names it.
+    pub fn add_angles(
+        &mut self,
+        source: &str,
+        t: Vec<f64>,
+        phi: &[f64],
+        displacement: Vec<Vec<f64>>,
+    ) -> Result<(), TransientError> {
+        if self.acq.is_some() {
+            return Err(TransientError::Unusable {
+                input: source.to_owned(),
+                reason: "this analysis takes raw records described by [acquisition], not records with a shaft angle",
+            });
+        }
+        if displacement.len() != self.probes.len() {
+            return Err(TransientError::LengthMismatch {
+                field: "displacements",
+                len: displacement.len(),
+                other: "probes",
+                expected: self.probes.len(),
+            })
+            .map_err(within(source));
+        }
+        let tracked = displacement
+            .iter()
+            .map(|d| track(&t, phi, d, &self.settings.order))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(within(format!("{source}: order tracking")))?;
+        let omega = angular_speed(&t, phi);
+        self.push(
+            source,
+            tracked,
+            Samples {
+                t,
+                omega,
+                displacement,
+            },
+        );
         Ok(())
     }
 
@@ -412,10 +535,14 @@ impl<'a> RawAnalysis<'a> {
                 Ok(vec![None; self.tracked.len()])
             }
             SlowRollChoice::Record { label, record } => {
+                let acq = self.acq.ok_or_else(|| TransientError::Unusable {
+                    input: label.clone(),
+                    reason: "a slow-roll record is a raw record of the scenario's [acquisition]; for records with a shaft angle take the runout from a speed range (or auto)",
+                })?;
                 let r = track_record(
                     &record,
-                    self.acq,
-                    self.probes(),
+                    acq,
+                    self.indices(),
                     &self.settings.order,
                     Which::SlowRoll,
                 )
@@ -468,7 +595,6 @@ impl<'a> RawAnalysis<'a> {
     /// (it must change by [`MIN_SPEED_CHANGE_PCT`]), the points binned when asked, the
     /// criticals with their margins.
     pub fn finish(self, slow_roll: SlowRollChoice) -> Result<Analysis, TransientError> {
-        let acq = self.acq;
         if self.tracked.is_empty() {
             return Err(TransientError::TooFew {
                 what: "records of the transient".into(),
@@ -479,11 +605,16 @@ impl<'a> RawAnalysis<'a> {
         speed_check(self.tracked[0].revolutions.iter().map(|r| r.rpm()))
             .map_err(within(self.sources.join(", ")))?;
         let mut notes = Vec::new();
-        if acq.single_probe {
+        if self.probes.len() == 1 {
             notes.push(format!(
                 "one probe ({}): everything but the full spectrum and the shaft centreline (they need an XY pair)",
-                acq.probes[0].column
+                self.probes[0].column
             ));
+        }
+        if self.acq.is_none() {
+            notes.push(
+                "the shaft angle is the record's phi (keyphasor events where phi passes a multiple of 2 pi): phase lags are measured from there".into(),
+            );
         }
         let srs = self.slow_roll(slow_roll, &mut notes)?;
         let mut sensors = Vec::new();
@@ -510,7 +641,7 @@ impl<'a> RawAnalysis<'a> {
                     dc: Some(r.dc),
                 })
                 .collect();
-            let p = &acq.probes[k];
+            let p = &self.probes[k];
             sensors.push(Sensor {
                 name: p.column.clone(),
                 angle_deg: Some(p.angle.to_degrees()),
@@ -521,8 +652,10 @@ impl<'a> RawAnalysis<'a> {
             });
         }
         let rpm: Vec<f64> = sensors[0].points.iter().map(|p| p.rpm).collect();
-        let dc_coupled = !acq.single_probe
-            && sensors.iter().zip(&acq.probes).all(|(s, p)| {
+        // a gap voltage needs volts: raw records of an XY pair only
+        let dc_coupled = self.acq.is_some()
+            && self.probes.len() == 2
+            && sensors.iter().zip(&self.probes).all(|(s, p)| {
                 let n = s.points.len().max(1) as f64;
                 let volts = s.points.iter().filter_map(|q| q.dc).sum::<f64>() / n * p.sensitivity;
                 volts.abs() >= DC_COUPLED_V
@@ -536,7 +669,8 @@ impl<'a> RawAnalysis<'a> {
             notes,
             operating_rpm: self.settings.operating_rpm,
             bin_rpm: self.settings.bin_rpm,
-            pair_angles: (!acq.single_probe).then(|| [acq.probes[0].angle, acq.probes[1].angle]),
+            pair_angles: (self.probes.len() == 2)
+                .then(|| [self.probes[0].angle, self.probes[1].angle]),
             dc_coupled,
             modes: None,
         };
@@ -872,5 +1006,89 @@ mod tests {
     fn an_empty_table_is_refused_by_name() {
         let e = analyse_table("t.csv", Vec::new(), &Settings::default()).unwrap_err();
         assert!(e.to_string().starts_with("t.csv: "), "{e}");
+    }
+
+    /// A record with its shaft angle (as `rotorid publish` sends one: t, x, z, phi): x and
+    /// z each the quasi-steady response of one mode, Re(V(w) e^{i phi}) with
+    /// V = A r^2 / (1 - r^2 + 2 i zeta r), r = w / wn, plus noise, on a slow sweep. Each
+    /// has its one critical at the closed form's peak, wn / sqrt(1 - 2 zeta^2).
+    #[test]
+    fn a_record_with_its_shaft_angle_gives_each_modes_critical() {
+        use rand::SeedableRng as _;
+        use rand_distr::Distribution as _;
+        let (rate, seconds) = (5000.0, 40.0);
+        let (w0, w1) = (
+            crate::model::rpm_to_rad_per_s(1000.0),
+            crate::model::rpm_to_rad_per_s(5000.0),
+        );
+        let acc = (w1 - w0) / seconds;
+        let n = (rate * seconds) as usize;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 / rate).collect();
+        let phi: Vec<f64> = t
+            .iter()
+            .map(|&t| 0.3 + w0 * t + 0.5 * acc * t * t)
+            .collect();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let noise = rand_distr::Normal::new(0.0, 2e-7).unwrap();
+        let modes = [(3000.0, 0.05), (3600.0, 0.04)];
+        let displacement: Vec<Vec<f64>> = modes
+            .iter()
+            .map(|&(nc, zeta)| {
+                t.iter()
+                    .zip(&phi)
+                    .map(|(&t, &p)| {
+                        let r = rad_per_s_to_rpm(w0 + acc * t) / nc;
+                        let v = C64::new(1e-5 * r * r, 0.0) / C64::new(1.0 - r * r, 2.0 * zeta * r);
+                        (v * C64::from_polar(1.0, p)).re + noise.sample(&mut rng)
+                    })
+                    .collect()
+            })
+            .collect();
+        let settings = Settings {
+            order: OrderSettings {
+                orders: vec![1],
+                ..OrderSettings::default()
+            },
+            ..Settings::default()
+        };
+        let mut a = RawAnalysis::with_angles(RawAnalysis::xz_probes(), settings).unwrap();
+        let raw = RawRecord {
+            columns: vec![("t".into(), t.clone())],
+        };
+        assert!(a
+            .add_record("r.csv", &raw)
+            .unwrap_err()
+            .to_string()
+            .starts_with("r.csv: "));
+        a.add_angles("r.csv", t, &phi, displacement).unwrap();
+        let out = a.finish(SlowRollChoice::None).unwrap();
+        assert_eq!(out.direction, Direction::RunUp);
+        assert_eq!(out.pair_angles, Some([0.0, std::f64::consts::FRAC_PI_2]));
+        assert!(!out.dc_coupled);
+        assert!(
+            out.notes.iter().any(|n| n.contains("phi")),
+            "{:?}",
+            out.notes
+        );
+        for (s, &(nc, zeta)) in out.sensors.iter().zip(&modes) {
+            let c = &s.criticals;
+            assert_eq!(c.len(), 1, "{}: {c:?}", s.name);
+            let peak = nc / (1.0 - 2.0 * zeta * zeta).sqrt();
+            assert!(
+                (c[0].critical.rpm / peak - 1.0).abs() < 3e-3,
+                "{}: {} rpm, closed form {peak}",
+                s.name,
+                c[0].critical.rpm
+            );
+            let af = c[0].critical.amplification_factor.unwrap();
+            assert!((af * 2.0 * zeta - 1.0).abs() < 0.1, "{}: AF {af}", s.name);
+        }
+        assert_eq!(
+            out.sensors
+                .iter()
+                .map(|s| s.name.as_str())
+                .collect::<Vec<_>>(),
+            ["x", "z"]
+        );
     }
 }

@@ -77,6 +77,15 @@ pub enum TransientError {
         /// The fewest samples per revolution that order needs.
         needed: usize,
     },
+    /// An input this analysis cannot take (a raw record where the shaft angle is given,
+    /// or the other way round).
+    #[error("{input}: {reason}")]
+    Unusable {
+        /// The input as given.
+        input: String,
+        /// Why, and what to give instead.
+        reason: &'static str,
+    },
     /// An error of one input or step (a record, a table's sensor), named first.
     #[error("{input}: {source}")]
     Within {

@@ -3,12 +3,14 @@
 //! compensated, with the critical speeds, their API 684 amplification factors and
 //! separation margins (docs/transient.md).
 //!
-//! Raw records are described by the scenario's `[acquisition]` (the scenario may hold
-//! nothing else): each probe's nX vectors per revolution (`rotorid::transient::order`),
-//! the runout subtracted (`rotorid::transient::slow_roll`), the criticals of each probe's
-//! compensated 1X (`rotorid::transient::critical`). Outputs in DIR: `bode.csv`,
-//! `transient.json`, `report.html` and the figures (PNG and SVG). Everything is computed
-//! before the first file is written, so an error leaves DIR as it was.
+//! A thin caller: the arguments, the files read (`rotorid_io::raw` for raw records, whose
+//! scenario's `[acquisition]` describes them; `rotorid_io::csv::bode` for a table), the
+//! analysis of the library (`rotorid::transient::analysis`: order tracking, slow-roll
+//! compensation, bins, criticals and margins, the same code as the Python package's), then
+//! the files (`rotorid::transient::report` gives transient.json and the bode.csv rows) and
+//! the figures. Outputs in DIR: `bode.csv`, `transient.json`, `report.html` and the figures
+//! (PNG and SVG). Everything is computed before the first file is written, so an error
+//! leaves DIR as it was.
 
 mod figures;
 mod output;
