@@ -176,15 +176,13 @@ pub async fn start(shared: Arc<Shared>, url: String, raw_backfill: u64) {
     js.set_timeout(Duration::from_secs(5));
     *shared.js.lock().expect("not poisoned") = Some(js.clone());
     let history = shared.state.read().expect("not poisoned").settings.history as u64;
-    // the newest result of every machine, whatever the streams still hold
-    tokio::spawn(seed_latest(Arc::clone(&shared), js.clone()));
     let ident = Reader {
         stream: IDENT_STREAM,
         prefix_len: "rotorid.ident.".len(),
         backfill: history,
         batch: 256,
     };
-    tokio::spawn(read(Arc::clone(&shared), js.clone(), ident, on_ident));
+    tokio::spawn(read_results(Arc::clone(&shared), js.clone(), ident));
     let alert = Reader {
         stream: ALERT_STREAM,
         prefix_len: "rotorid.alert.".len(),
@@ -400,35 +398,93 @@ async fn read_from(
     why
 }
 
-/// Read `ROTORID_LATEST` once: every machine's newest result.
-async fn seed_latest(shared: Arc<Shared>, js: jetstream::Context) {
-    let Ok(kv) = js.get_key_value(LATEST_BUCKET).await else {
-        return;
-    };
-    let Ok(mut keys) = kv.keys().await else {
-        return;
-    };
-    let mut ids = Vec::new();
-    while let Some(Ok(k)) = keys.next().await {
-        ids.push(k);
+/// The results: every machine's newest result from `ROTORID_LATEST` first, then
+/// `ROTORID_IDENT` for ever ([`read`]).
+///
+/// The seed is read once, and always before the first message of the stream: a worker
+/// stores a window's result before it updates `ROTORID_LATEST`, so every window the seed
+/// gives is in the stream at or before the sequence the reader then starts from, and a
+/// tile's newest window is never one whose stream copy is yet to be counted in `results`,
+/// except the seeded windows themselves until their copies come. (The seed used to be a
+/// task of its own: read late, after an outage say, it put a newer window on a tile than
+/// the reader had counted.)
+async fn read_results(shared: Arc<Shared>, js: jetstream::Context, r: Reader) {
+    loop {
+        let attempt = tokio::time::timeout(Duration::from_secs(30), seed_latest(&shared, &js));
+        let e = match attempt.await {
+            Ok(Ok(())) => break,
+            Ok(Err(e)) => e,
+            Err(_) => format!("bucket {LATEST_BUCKET}: not read within 30 s"),
+        };
+        shared.problem(LATEST_BUCKET, Some(e));
+        tokio::time::sleep(Duration::from_secs(1)).await;
     }
+    shared.problem(LATEST_BUCKET, None);
+    read(shared, js, r, on_ident).await;
+}
+
+/// Read `ROTORID_LATEST`: every machine's newest result. Its keys are listed by the
+/// subjects of its stream (one request, paged), not by a key watcher (an ordered consumer
+/// that ends only when it sees nothing pending, which a bucket being written may never
+/// show). No bucket yet: nothing to read.
+async fn seed_latest(shared: &Shared, js: &jetstream::Context) -> Result<(), String> {
+    let bucket_stream = format!("KV_{LATEST_BUCKET}");
+    let stream = match js.get_stream(&bucket_stream).await {
+        Ok(s) => s,
+        Err(e) => {
+            use async_nats::jetstream::context::GetStreamErrorKind;
+            use async_nats::jetstream::ErrorCode;
+            return match e.kind() {
+                GetStreamErrorKind::JetStream(j)
+                    if j.error_code() == ErrorCode::STREAM_NOT_FOUND =>
+                {
+                    Ok(())
+                }
+                _ => Err(format!("bucket {LATEST_BUCKET}: {e}")),
+            };
+        }
+    };
+    let prefix = format!("$KV.{LATEST_BUCKET}.");
+    let mut ids = Vec::new();
+    let mut subjects = stream
+        .info_with_subjects(format!("{prefix}>"))
+        .await
+        .map_err(|e| format!("bucket {LATEST_BUCKET}: {e}"))?;
+    while let Some(s) = subjects.next().await {
+        let (subject, _) = s.map_err(|e| format!("bucket {LATEST_BUCKET}: {e}"))?;
+        if let Some(id) = subject.strip_prefix(&prefix) {
+            ids.push(id.to_owned());
+        }
+    }
+    let kv = js
+        .get_key_value(LATEST_BUCKET)
+        .await
+        .map_err(|e| format!("bucket {LATEST_BUCKET}: {e}"))?;
     for id in ids {
         if rotorid_fleet::frame::check_machine_id(&id).is_err() {
             continue;
         }
-        if let Ok(Some(e)) = kv.entry(id.as_str()).await {
-            // sequence 0: the window's summary is served from memory while it is the newest
-            let r = shared.state.write().expect("not poisoned").apply_result(
-                &id,
-                0,
-                ms_of(e.created),
-                &e.value,
-            );
-            if r.is_ok() {
-                shared.changed(&id);
-            }
+        let entry = kv
+            .entry(id.as_str())
+            .await
+            .map_err(|e| format!("bucket {LATEST_BUCKET} key {id}: {e}"))?;
+        let Some(e) = entry.filter(|e| e.operation == async_nats::jetstream::kv::Operation::Put)
+        else {
+            continue;
+        };
+        // sequence 0: counted when its stream copy comes; the window's summary is served
+        // from memory while it is the newest
+        let r = shared.state.write().expect("not poisoned").apply_result(
+            &id,
+            0,
+            ms_of(e.created),
+            &e.value,
+        );
+        if r.is_ok() {
+            shared.changed(&id);
         }
     }
+    Ok(())
 }
 
 /// Every 2 s: the drift baseline of each machine that has none yet and has new windows.
