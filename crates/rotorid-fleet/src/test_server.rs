@@ -62,8 +62,9 @@ impl Server {
         self.child = Some(child);
         let t = Instant::now();
         while TcpStream::connect(("127.0.0.1", self.port)).is_err() {
+            // against a hang only: a busy machine may be slow to start it
             assert!(
-                t.elapsed() < Duration::from_secs(20),
+                t.elapsed() < Duration::from_secs(120),
                 "nats-server did not start"
             );
             std::thread::sleep(Duration::from_millis(50));
