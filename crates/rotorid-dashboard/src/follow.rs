@@ -41,8 +41,11 @@ pub enum Change {
 /// The connection to NATS as the pages show it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct NatsStatus {
-    /// The server's URL.
+    /// The servers' URLs, as given (a comma-separated list).
     pub url: String,
+    /// The server the dashboard is on (`nats://HOST:PORT (server NAME)`), or was on last
+    /// while disconnected; `null` before the first connection.
+    pub server: Option<String>,
     /// Connected now.
     pub connected: bool,
     /// Since when (connected or not) \[ms since 1970, UTC\].
@@ -84,6 +87,7 @@ impl Shared {
             state: RwLock::new(state),
             nats: Mutex::new(NatsStatus {
                 url: url.to_owned(),
+                server: None,
                 connected: false,
                 since_ms: now_ms(),
                 problems: BTreeMap::from([(
@@ -101,8 +105,11 @@ impl Shared {
         self.nats.lock().expect("not poisoned").clone()
     }
 
-    fn set_connected(&self, connected: bool) {
+    fn set_connected(&self, connected: bool, server: Option<String>) {
         let mut n = self.nats.lock().expect("not poisoned");
+        if server.is_some() {
+            n.server = server;
+        }
         if n.connected != connected {
             n.connected = connected;
             n.since_ms = now_ms();
@@ -110,7 +117,14 @@ impl Shared {
         if connected {
             n.problems.remove("connection");
         } else {
-            let what = format!("NATS server {} unreachable: reconnecting", n.url);
+            let what = match &n.server {
+                Some(on) => format!(
+                    "NATS server {on} unreachable: reconnecting to any server of {} or its \
+                     cluster",
+                    n.url
+                ),
+                None => format!("NATS server {} unreachable: reconnecting", n.url),
+            };
             n.problems.insert("connection".into(), what);
         }
         drop(n);
@@ -143,20 +157,36 @@ struct Reader {
     batch: usize,
 }
 
-/// Connect to `url` (retrying for ever) and start the readers (module doc); returns at
-/// once.
+/// Connect to the servers `url` (a comma-separated list; retrying for ever, any of them
+/// and of their cluster) and start the readers (module doc); returns at once.
 pub async fn start(shared: Arc<Shared>, url: String, raw_backfill: u64) {
+    let addrs = match rotorid_fleet::nats::parse_servers(&url) {
+        Ok(a) => a,
+        Err(e) => {
+            shared.problem("connection", Some(e.to_string()));
+            return;
+        }
+    };
     let s = Arc::clone(&shared);
+    let cell: Arc<std::sync::OnceLock<async_nats::Client>> = Arc::default();
+    let cell2 = Arc::clone(&cell);
     let options = async_nats::ConnectOptions::new()
         .retry_on_initial_connect()
         .max_reconnects(None)
+        .retain_servers_order()
         .connection_timeout(Duration::from_secs(2))
         .event_callback(move |e| {
-            let s = Arc::clone(&s);
+            let (s, cell) = (Arc::clone(&s), Arc::clone(&cell2));
             async move {
                 match e {
-                    async_nats::Event::Connected => s.set_connected(true),
-                    async_nats::Event::Disconnected => s.set_connected(false),
+                    async_nats::Event::Connected => {
+                        // which server: the client's INFO of this connection
+                        let on = cell
+                            .get()
+                            .map(|c| rotorid_fleet::nats::describe_server(&c.server_info()));
+                        s.set_connected(true, on);
+                    }
+                    async_nats::Event::Disconnected => s.set_connected(false, None),
                     async_nats::Event::SlowConsumer(_) => s.problem(
                         "client",
                         Some("the dashboard reads messages slower than they come".into()),
@@ -165,13 +195,18 @@ pub async fn start(shared: Arc<Shared>, url: String, raw_backfill: u64) {
                 }
             }
         });
-    let client = match options.connect(url.as_str()).await {
+    let client = match options.connect(addrs).await {
         Ok(c) => c,
         Err(e) => {
             shared.problem("connection", Some(format!("NATS {url}: {e}")));
             return;
         }
     };
+    let _ = cell.set(client.clone());
+    if client.connection_state() == async_nats::connection::State::Connected {
+        let on = rotorid_fleet::nats::describe_server(&client.server_info());
+        shared.set_connected(true, Some(on));
+    }
     let mut js = jetstream::new(client.clone());
     js.set_timeout(Duration::from_secs(5));
     *shared.js.lock().expect("not poisoned") = Some(js.clone());
