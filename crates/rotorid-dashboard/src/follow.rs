@@ -41,8 +41,11 @@ pub enum Change {
 /// The connection to NATS as the pages show it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct NatsStatus {
-    /// The server's URL.
+    /// The servers' URLs, as given (a comma-separated list).
     pub url: String,
+    /// The server the dashboard is on (`nats://HOST:PORT (server NAME)`), or was on last
+    /// while disconnected; `null` before the first connection.
+    pub server: Option<String>,
     /// Connected now.
     pub connected: bool,
     /// Since when (connected or not) \[ms since 1970, UTC\].
@@ -84,6 +87,7 @@ impl Shared {
             state: RwLock::new(state),
             nats: Mutex::new(NatsStatus {
                 url: url.to_owned(),
+                server: None,
                 connected: false,
                 since_ms: now_ms(),
                 problems: BTreeMap::from([(
@@ -101,8 +105,11 @@ impl Shared {
         self.nats.lock().expect("not poisoned").clone()
     }
 
-    fn set_connected(&self, connected: bool) {
+    fn set_connected(&self, connected: bool, server: Option<String>) {
         let mut n = self.nats.lock().expect("not poisoned");
+        if server.is_some() {
+            n.server = server;
+        }
         if n.connected != connected {
             n.connected = connected;
             n.since_ms = now_ms();
@@ -110,7 +117,14 @@ impl Shared {
         if connected {
             n.problems.remove("connection");
         } else {
-            let what = format!("NATS server {} unreachable: reconnecting", n.url);
+            let what = match &n.server {
+                Some(on) => format!(
+                    "NATS server {on} unreachable: reconnecting to any server of {} or its \
+                     cluster",
+                    n.url
+                ),
+                None => format!("NATS server {} unreachable: reconnecting", n.url),
+            };
             n.problems.insert("connection".into(), what);
         }
         drop(n);
@@ -143,20 +157,36 @@ struct Reader {
     batch: usize,
 }
 
-/// Connect to `url` (retrying for ever) and start the readers (module doc); returns at
-/// once.
+/// Connect to the servers `url` (a comma-separated list; retrying for ever, any of them
+/// and of their cluster) and start the readers (module doc); returns at once.
 pub async fn start(shared: Arc<Shared>, url: String, raw_backfill: u64) {
+    let addrs = match rotorid_fleet::nats::parse_servers(&url) {
+        Ok(a) => a,
+        Err(e) => {
+            shared.problem("connection", Some(e.to_string()));
+            return;
+        }
+    };
     let s = Arc::clone(&shared);
+    let cell: Arc<std::sync::OnceLock<async_nats::Client>> = Arc::default();
+    let cell2 = Arc::clone(&cell);
     let options = async_nats::ConnectOptions::new()
         .retry_on_initial_connect()
         .max_reconnects(None)
+        .retain_servers_order()
         .connection_timeout(Duration::from_secs(2))
         .event_callback(move |e| {
-            let s = Arc::clone(&s);
+            let (s, cell) = (Arc::clone(&s), Arc::clone(&cell2));
             async move {
                 match e {
-                    async_nats::Event::Connected => s.set_connected(true),
-                    async_nats::Event::Disconnected => s.set_connected(false),
+                    async_nats::Event::Connected => {
+                        // which server: the client's INFO of this connection
+                        let on = cell
+                            .get()
+                            .map(|c| rotorid_fleet::nats::describe_server(&c.server_info()));
+                        s.set_connected(true, on);
+                    }
+                    async_nats::Event::Disconnected => s.set_connected(false, None),
                     async_nats::Event::SlowConsumer(_) => s.problem(
                         "client",
                         Some("the dashboard reads messages slower than they come".into()),
@@ -165,26 +195,29 @@ pub async fn start(shared: Arc<Shared>, url: String, raw_backfill: u64) {
                 }
             }
         });
-    let client = match options.connect(url.as_str()).await {
+    let client = match options.connect(addrs).await {
         Ok(c) => c,
         Err(e) => {
             shared.problem("connection", Some(format!("NATS {url}: {e}")));
             return;
         }
     };
+    let _ = cell.set(client.clone());
+    if client.connection_state() == async_nats::connection::State::Connected {
+        let on = rotorid_fleet::nats::describe_server(&client.server_info());
+        shared.set_connected(true, Some(on));
+    }
     let mut js = jetstream::new(client.clone());
     js.set_timeout(Duration::from_secs(5));
     *shared.js.lock().expect("not poisoned") = Some(js.clone());
     let history = shared.state.read().expect("not poisoned").settings.history as u64;
-    // the newest result of every machine, whatever the streams still hold
-    tokio::spawn(seed_latest(Arc::clone(&shared), js.clone()));
     let ident = Reader {
         stream: IDENT_STREAM,
         prefix_len: "rotorid.ident.".len(),
         backfill: history,
         batch: 256,
     };
-    tokio::spawn(read(Arc::clone(&shared), js.clone(), ident, on_ident));
+    tokio::spawn(read_results(Arc::clone(&shared), js.clone(), ident));
     let alert = Reader {
         stream: ALERT_STREAM,
         prefix_len: "rotorid.alert.".len(),
@@ -400,35 +433,93 @@ async fn read_from(
     why
 }
 
-/// Read `ROTORID_LATEST` once: every machine's newest result.
-async fn seed_latest(shared: Arc<Shared>, js: jetstream::Context) {
-    let Ok(kv) = js.get_key_value(LATEST_BUCKET).await else {
-        return;
-    };
-    let Ok(mut keys) = kv.keys().await else {
-        return;
-    };
-    let mut ids = Vec::new();
-    while let Some(Ok(k)) = keys.next().await {
-        ids.push(k);
+/// The results: every machine's newest result from `ROTORID_LATEST` first, then
+/// `ROTORID_IDENT` for ever ([`read`]).
+///
+/// The seed is read once, and always before the first message of the stream: a worker
+/// stores a window's result before it updates `ROTORID_LATEST`, so every window the seed
+/// gives is in the stream at or before the sequence the reader then starts from, and a
+/// tile's newest window is never one whose stream copy is yet to be counted in `results`,
+/// except the seeded windows themselves until their copies come. (The seed used to be a
+/// task of its own: read late, after an outage say, it put a newer window on a tile than
+/// the reader had counted.)
+async fn read_results(shared: Arc<Shared>, js: jetstream::Context, r: Reader) {
+    loop {
+        let attempt = tokio::time::timeout(Duration::from_secs(30), seed_latest(&shared, &js));
+        let e = match attempt.await {
+            Ok(Ok(())) => break,
+            Ok(Err(e)) => e,
+            Err(_) => format!("bucket {LATEST_BUCKET}: not read within 30 s"),
+        };
+        shared.problem(LATEST_BUCKET, Some(e));
+        tokio::time::sleep(Duration::from_secs(1)).await;
     }
+    shared.problem(LATEST_BUCKET, None);
+    read(shared, js, r, on_ident).await;
+}
+
+/// Read `ROTORID_LATEST`: every machine's newest result. Its keys are listed by the
+/// subjects of its stream (one request, paged), not by a key watcher (an ordered consumer
+/// that ends only when it sees nothing pending, which a bucket being written may never
+/// show). No bucket yet: nothing to read.
+async fn seed_latest(shared: &Shared, js: &jetstream::Context) -> Result<(), String> {
+    let bucket_stream = format!("KV_{LATEST_BUCKET}");
+    let stream = match js.get_stream(&bucket_stream).await {
+        Ok(s) => s,
+        Err(e) => {
+            use async_nats::jetstream::context::GetStreamErrorKind;
+            use async_nats::jetstream::ErrorCode;
+            return match e.kind() {
+                GetStreamErrorKind::JetStream(j)
+                    if j.error_code() == ErrorCode::STREAM_NOT_FOUND =>
+                {
+                    Ok(())
+                }
+                _ => Err(format!("bucket {LATEST_BUCKET}: {e}")),
+            };
+        }
+    };
+    let prefix = format!("$KV.{LATEST_BUCKET}.");
+    let mut ids = Vec::new();
+    let mut subjects = stream
+        .info_with_subjects(format!("{prefix}>"))
+        .await
+        .map_err(|e| format!("bucket {LATEST_BUCKET}: {e}"))?;
+    while let Some(s) = subjects.next().await {
+        let (subject, _) = s.map_err(|e| format!("bucket {LATEST_BUCKET}: {e}"))?;
+        if let Some(id) = subject.strip_prefix(&prefix) {
+            ids.push(id.to_owned());
+        }
+    }
+    let kv = js
+        .get_key_value(LATEST_BUCKET)
+        .await
+        .map_err(|e| format!("bucket {LATEST_BUCKET}: {e}"))?;
     for id in ids {
         if rotorid_fleet::frame::check_machine_id(&id).is_err() {
             continue;
         }
-        if let Ok(Some(e)) = kv.entry(id.as_str()).await {
-            // sequence 0: the window's summary is served from memory while it is the newest
-            let r = shared.state.write().expect("not poisoned").apply_result(
-                &id,
-                0,
-                ms_of(e.created),
-                &e.value,
-            );
-            if r.is_ok() {
-                shared.changed(&id);
-            }
+        let entry = kv
+            .entry(id.as_str())
+            .await
+            .map_err(|e| format!("bucket {LATEST_BUCKET} key {id}: {e}"))?;
+        let Some(e) = entry.filter(|e| e.operation == async_nats::jetstream::kv::Operation::Put)
+        else {
+            continue;
+        };
+        // sequence 0: counted when its stream copy comes; the window's summary is served
+        // from memory while it is the newest
+        let r = shared.state.write().expect("not poisoned").apply_result(
+            &id,
+            0,
+            ms_of(e.created),
+            &e.value,
+        );
+        if r.is_ok() {
+            shared.changed(&id);
         }
     }
+    Ok(())
 }
 
 /// Every 2 s: the drift baseline of each machine that has none yet and has new windows.

@@ -105,6 +105,40 @@ pub enum FleetError {
         /// The client's message.
         message: String,
     },
+    /// A NATS server list that is not one.
+    #[error(
+        "NATS server {url:?}: {message} (a server list is URLs separated by commas, e.g. \
+         nats://10.0.0.1:4222,nats://10.0.0.2:4222, or the option given again per server)"
+    )]
+    ServerList {
+        /// The item of the list.
+        url: String,
+        /// Why it is not a server.
+        message: String,
+    },
+    /// A replica count out of range.
+    #[error("replicas = {replicas} is out of range: {allowed}")]
+    ReplicasRange {
+        /// The count asked for.
+        replicas: usize,
+        /// What is allowed.
+        allowed: &'static str,
+    },
+    /// A stream of the fleet that the servers cannot hold with the replicas asked for (a
+    /// cluster smaller than the replica count, or a single server).
+    #[error(
+        "replicas = {replicas}: the NATS servers refuse stream {stream} with {replicas} \
+         replicas ({message}): N replicas need a JetStream cluster of at least N servers \
+         (--replicas 1 on a single server)"
+    )]
+    Replicas {
+        /// The count asked for.
+        replicas: usize,
+        /// The stream.
+        stream: String,
+        /// The server's answer.
+        message: String,
+    },
     /// A message that is not the JSON it should be.
     #[error("{subject}: not a valid {what}: {message}")]
     Json {

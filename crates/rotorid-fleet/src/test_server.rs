@@ -2,6 +2,10 @@
 //! directory the test chooses, on a free loopback port; killed when dropped. Used by this
 //! crate's end-to-end tests and the `rotorid` command's fleet tests. Needs the Debian
 //! package `nats-server` (`.ci/test` installs it) or `$NATS_SERVER`.
+//!
+//! [`Cluster`]: three (or more) such servers in one JetStream cluster
+//! (`--cluster_name`, `--cluster`, `--routes`, each with its own store directory), for the
+//! tests that lose a node for good.
 
 use std::net::TcpStream;
 use std::path::{Path, PathBuf};
@@ -62,8 +66,9 @@ impl Server {
         self.child = Some(child);
         let t = Instant::now();
         while TcpStream::connect(("127.0.0.1", self.port)).is_err() {
+            // against a hang only: a busy machine may be slow to start it
             assert!(
-                t.elapsed() < Duration::from_secs(20),
+                t.elapsed() < Duration::from_secs(120),
                 "nats-server did not start"
             );
             std::thread::sleep(Duration::from_millis(50));
@@ -103,5 +108,120 @@ impl Server {
 impl Drop for Server {
     fn drop(&mut self) {
         self.kill();
+    }
+}
+
+/// A JetStream cluster of nats-servers of our own on loopback ports, each with its own
+/// store directory; every node still running is killed when dropped.
+pub struct Cluster {
+    /// The nodes' client ports, by index.
+    pub ports: Vec<u16>,
+    children: Vec<Option<Child>>,
+}
+
+/// GET `path` of the monitoring port `port`: the body, when it answers.
+fn monitor_get(port: u16, path: &str) -> Option<String> {
+    use std::io::{Read as _, Write as _};
+    let mut s = TcpStream::connect(("127.0.0.1", port)).ok()?;
+    s.set_read_timeout(Some(Duration::from_secs(5))).ok()?;
+    write!(
+        s,
+        "GET {path} HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n"
+    )
+    .ok()?;
+    let mut body = String::new();
+    s.read_to_string(&mut body).ok()?;
+    body.split_once("\r\n\r\n").map(|(_, b)| b.to_owned())
+}
+
+impl Cluster {
+    /// Start `n` nodes named `n0`, `n1`, ... (cluster `rotorid-test`), node i storing in
+    /// `dir/n<i>`, and wait until every node is up and JetStream has elected its meta
+    /// leader with all `n` peers (a condition, for up to 60 s: a busy machine is slow).
+    pub fn start(dir: &Path, n: usize) -> Self {
+        let ports: Vec<u16> = (0..n).map(|_| free_port()).collect();
+        let routes: Vec<u16> = (0..n).map(|_| free_port()).collect();
+        let monitors: Vec<u16> = (0..n).map(|_| free_port()).collect();
+        let route_list = routes
+            .iter()
+            .map(|p| format!("nats://127.0.0.1:{p}"))
+            .collect::<Vec<_>>()
+            .join(",");
+        let mut children = Vec::new();
+        for i in 0..n {
+            let child = Command::new(nats_server())
+                .args(["-js", "-a", "127.0.0.1", "-p"])
+                .arg(ports[i].to_string())
+                .args(["-n", &format!("n{i}"), "-m"])
+                .arg(monitors[i].to_string())
+                .arg("-sd")
+                .arg(dir.join(format!("n{i}")))
+                .args(["--cluster_name", "rotorid-test", "--cluster"])
+                .arg(format!("nats://127.0.0.1:{}", routes[i]))
+                .args(["--routes", &route_list])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .expect(
+                    "nats-server is not installed: `apt-get install -y nats-server` (.ci/test \
+                     does it)",
+                );
+            children.push(Some(child));
+        }
+        let c = Self { ports, children };
+        let t = Instant::now();
+        // every node is a member of the meta group and knows its leader
+        let ready = |m: u16| {
+            monitor_get(m, "/jsz").is_some_and(|b| {
+                let size = format!("\"cluster_size\": {n}");
+                let size2 = format!("\"cluster_size\":{n}");
+                (b.contains(&size) || b.contains(&size2)) && b.contains("\"leader\"")
+            }) && monitor_get(m, "/healthz").is_some_and(|b| b.contains("ok"))
+        };
+        while !monitors.iter().all(|&m| ready(m)) {
+            assert!(
+                t.elapsed() < Duration::from_secs(60),
+                "the nats-server cluster did not form"
+            );
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        c
+    }
+
+    /// The client URL of node `i`.
+    pub fn url(&self, i: usize) -> String {
+        format!("nats://127.0.0.1:{}", self.ports[i])
+    }
+
+    /// Every node's URL, comma-separated, node 0 first.
+    pub fn urls(&self) -> String {
+        (0..self.ports.len())
+            .map(|i| self.url(i))
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+
+    /// The index of the node named `name` (`n1` -> 1).
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        name.strip_prefix('n')?
+            .parse()
+            .ok()
+            .filter(|&i: &usize| i < self.ports.len())
+    }
+
+    /// SIGKILL node `i`, for good.
+    pub fn kill(&mut self, i: usize) {
+        if let Some(mut c) = self.children[i].take() {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+impl Drop for Cluster {
+    fn drop(&mut self) {
+        for i in 0..self.children.len() {
+            self.kill(i);
+        }
     }
 }

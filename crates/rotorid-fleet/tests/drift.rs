@@ -117,7 +117,8 @@ async fn a_five_percent_kx_drop_alerts_within_two_windows_and_nothing_else_does(
             break;
         }
         assert!(
-            started.elapsed() < Duration::from_secs(240),
+            // a deadline only against a hang, not a speed test
+            started.elapsed() < Duration::from_secs(600),
             "{n} of {total} results"
         );
         tokio::time::sleep(Duration::from_millis(200)).await;

@@ -19,9 +19,11 @@ use rotorid_fleet::worker::shutdown_signal;
                         /etc/rotorid/token\n    then open http://HOST:8080/?token=TOKEN once"
 )]
 pub struct DashboardArgs {
-    /// The NATS server the workers use.
-    #[arg(long, value_name = "URL")]
-    pub nats: String,
+    /// The NATS servers the workers use: a URL, or several separated by commas or given with --nats
+    /// again (any servers of a cluster; the first reachable one, in this order, is used,
+    /// and the client reconnects to any live server of the cluster).
+    #[arg(long, value_name = "URL[,URL...]", required = true)]
+    pub nats: Vec<String>,
     /// Address and port to listen on (port 0: any free port, printed). An address other
     /// than loopback needs --token-file.
     #[arg(long, value_name = "ADDR:PORT", default_value = "127.0.0.1:8080")]
@@ -63,9 +65,11 @@ fn read_token(path: &PathBuf) -> anyhow::Result<String> {
 
 /// Run `rotorid dashboard`.
 pub fn run(args: DashboardArgs) -> anyhow::Result<()> {
+    let servers = rotorid_fleet::nats::join_servers(&args.nats)
+        .map_err(|e| anyhow::anyhow!("--nats: {e}"))?;
     let token = args.token_file.as_ref().map(read_token).transpose()?;
     let config = Config {
-        nats: args.nats.clone(),
+        nats: servers.clone(),
         listen: args.listen,
         token,
         settings: Settings {
@@ -88,10 +92,7 @@ pub fn run(args: DashboardArgs) -> anyhow::Result<()> {
         } else {
             ""
         };
-        outln!(
-            "rotorid dashboard: http://{addr}/ reading {}{how}",
-            args.nats
-        )?;
+        outln!("rotorid dashboard: http://{addr}/ reading {servers}{how}")?;
         d.run(shutdown_signal()).await?;
         anyhow::Ok(())
     })

@@ -22,9 +22,11 @@ pub struct PublishArgs {
     /// The recording: a response CSV t,x,z[,phi,phi_dot,phi_ddot] in SI (s, m, rad, rad/s,
     /// rad/s^2), uniformly sampled.
     pub file: String,
-    /// The NATS server.
-    #[arg(long, value_name = "URL")]
-    pub nats: String,
+    /// The NATS servers: a URL, or several separated by commas or given with --nats
+    /// again (any servers of a cluster; the first reachable one, in this order, is used,
+    /// and the client reconnects to any live server of the cluster).
+    #[arg(long, value_name = "URL[,URL...]", required = true)]
+    pub nats: Vec<String>,
     /// The machine's id: letters, digits, '_' and '-' (one NATS subject token).
     #[arg(long, value_name = "ID")]
     pub machine: String,
@@ -38,6 +40,11 @@ pub struct PublishArgs {
     /// Window length [s].
     #[arg(long, value_name = "S", default_value_t = 1.0)]
     pub window_s: f64,
+    /// Replicas of the streams, buckets and consumers this command creates (1 ..= 5; on a
+    /// cluster of N servers, 3 survives the loss of one server). A stream that exists
+    /// with fewer is reported, not changed: `rotorid fleet replicas N` changes it.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub replicas: usize,
     /// Number of the first window (windows are numbered per machine, increasing with
     /// time: continue a machine's numbering for its next recording).
     #[arg(long, value_name = "N", default_value_t = 0)]
@@ -100,6 +107,10 @@ pub fn run(args: PublishArgs) -> anyhow::Result<()> {
             args.window_s
         );
     }
+    let servers = rotorid_fleet::nats::join_servers(&args.nats)
+        .map_err(|e| anyhow::anyhow!("--nats: {e}"))?;
+    rotorid_fleet::nats::check_replicas(args.replicas)
+        .map_err(|e| anyhow::anyhow!("--replicas: {e}"))?;
     let (grid, mut channels) = read_recording(&args.file)?;
     if channels.len() == 2 {
         if let Some(s) = &args.scenario {
@@ -146,13 +157,23 @@ pub fn run(args: PublishArgs) -> anyhow::Result<()> {
         RateArg::Realtime => Rate::Realtime,
         RateArg::Max => Rate::Max,
     };
+    let wait_after = test_hook_wait_after()?;
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()?;
     let report = rt.block_on(async {
-        let fleet = Fleet::connect(&args.nats, Duration::from_secs(10)).await?;
+        let fleet = Fleet::connect_reporting(&servers, Duration::from_secs(10), "publish")
+            .await?
+            .with_replicas(args.replicas)?;
+        fleet.raw_stream().await?;
+        crate::commands::fleet::report_shortfalls(&fleet, &servers, "publish").await?;
         publish_frames(&fleet, &frames, rate, |f| {
             eprintln!("window {} (t0 = {} s) acknowledged", f.window, f.t0);
+            if let Some((after, path)) = &wait_after {
+                if f.window == *after {
+                    wait_for_file(path);
+                }
+            }
         })
         .await
     })?;
@@ -161,4 +182,30 @@ pub fn run(args: PublishArgs) -> anyhow::Result<()> {
         report.windows, args.machine, args.machine, report.duplicates, report.bytes
     );
     Ok(())
+}
+
+/// A hook for the tests that lose a server in the middle of a recording:
+/// `ROTORID_PUBLISH_WAIT_AFTER=W:PATH` makes the publisher, once window W is acknowledged,
+/// say `waiting for PATH` on stderr and wait until PATH exists before the next window, so
+/// that what the test does meanwhile (kill a server) provably lands mid-recording.
+fn test_hook_wait_after() -> anyhow::Result<Option<(u64, std::path::PathBuf)>> {
+    let Some(v) = std::env::var_os("ROTORID_PUBLISH_WAIT_AFTER") else {
+        return Ok(None);
+    };
+    let parsed = v.to_str().and_then(|v| {
+        let (w, p) = v.split_once(':')?;
+        Some((w.parse::<u64>().ok()?, std::path::PathBuf::from(p)))
+    });
+    match parsed {
+        Some(p) => Ok(Some(p)),
+        None => anyhow::bail!("ROTORID_PUBLISH_WAIT_AFTER = {v:?} is not WINDOW:PATH"),
+    }
+}
+
+/// Block until `path` exists (the test hook above).
+fn wait_for_file(path: &std::path::Path) {
+    eprintln!("publish: waiting for {}", path.display());
+    while !path.exists() {
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }

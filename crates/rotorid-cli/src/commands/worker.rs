@@ -19,9 +19,16 @@ use crate::commands::identify::{method_of, IdentifyMethod, MethodOptions};
                         --unknowns m,kx,kz --window 0.05"
 )]
 pub struct WorkerArgs {
-    /// The NATS server.
-    #[arg(long, value_name = "URL")]
-    pub nats: String,
+    /// The NATS servers: a URL, or several separated by commas or given with --nats
+    /// again (any servers of a cluster; the first reachable one, in this order, is used,
+    /// and the client reconnects to any live server of the cluster).
+    #[arg(long, value_name = "URL[,URL...]", required = true)]
+    pub nats: Vec<String>,
+    /// Replicas of the streams, buckets and consumers this command creates (1 ..= 5; on a
+    /// cluster of N servers, 3 survives the loss of one server). A stream that exists
+    /// with fewer is reported, not changed: `rotorid fleet replicas N` changes it.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub replicas: usize,
     /// The durable consumer's name: workers with the same name share the windows.
     #[arg(long, value_name = "NAME", default_value = rotorid_fleet::DEFAULT_DURABLE)]
     pub durable: String,
@@ -82,6 +89,10 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
             args.z_threshold
         );
     }
+    let servers = rotorid_fleet::nats::join_servers(&args.nats)
+        .map_err(|e| anyhow::anyhow!("--nats: {e}"))?;
+    rotorid_fleet::nats::check_replicas(args.replicas)
+        .map_err(|e| anyhow::anyhow!("--replicas: {e}"))?;
     let mut cfg = WorkerConfig::new(method, scenarios);
     cfg.durable = args.durable;
     cfg.baselines = args.baselines;
@@ -96,10 +107,15 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
         .enable_all()
         .build()?;
     let stats = rt.block_on(async {
-        let fleet = Fleet::connect(&args.nats, Duration::from_secs(10)).await?;
+        let fleet = Fleet::connect_reporting(&servers, Duration::from_secs(10), "worker")
+            .await?
+            .with_replicas(args.replicas)?;
+        rotorid_fleet::worker::prepare(&fleet, &cfg).await?;
+        crate::commands::fleet::report_shortfalls(&fleet, &servers, "worker").await?;
         eprintln!(
             "worker on {} (consumer {}): waiting for windows",
-            args.nats, cfg.durable
+            fleet.server(),
+            cfg.durable
         );
         run_worker(&fleet, &cfg, shutdown_signal()).await
     })?;

@@ -19,7 +19,7 @@ use serde_json::Value;
 use crate::common::rotorid;
 
 /// Generous: a busy CI machine may take long; a condition met returns at once.
-pub const PATIENCE: Duration = Duration::from_secs(180);
+pub const PATIENCE: Duration = Duration::from_secs(600);
 
 /// A child process killed when dropped.
 pub struct Proc(pub Option<Child>);

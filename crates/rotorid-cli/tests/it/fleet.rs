@@ -339,3 +339,95 @@ fn worker_settings_are_checked_against_the_method_before_connecting() {
         assert!(err.contains(want), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn server_lists_and_replica_counts_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let server = Server::start(&dir.path().join("js"));
+    let url = server.url();
+    let rec = dir.path().join("r.csv");
+    let rec = rec.to_str().unwrap();
+    run(&[
+        "simulate",
+        "--scenario",
+        "table1",
+        "--duration",
+        "0.5",
+        "--out",
+        rec,
+        "-q",
+    ]);
+    // a dead first server (nothing listens on port 1), then ours, given as a list and again
+    // with --nats repeated: the command connects, and says which server it is on
+    let list = format!("nats://127.0.0.1:1, {url}");
+    for nats in [
+        vec!["--nats", list.as_str()],
+        vec!["--nats", "nats://127.0.0.1:1", "--nats", url.as_str()],
+    ] {
+        let out = rotorid()
+            .args(["publish", rec, "--machine", "rig-9", "--window-s", "0.25"])
+            .args(&nats)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{nats:?}: {err}");
+        assert!(
+            err.contains(&format!(
+                "publish: NATS: on nats://127.0.0.1:{}",
+                server.port
+            )),
+            "{err}"
+        );
+    }
+    let status = run(&[
+        "fleet",
+        "status",
+        "--nats",
+        &format!("nats://127.0.0.1:1,{url}"),
+    ]);
+    assert!(status.contains("rig-9"), "{status}");
+    // a stream that exists with fewer replicas is reported, and left as it is
+    let out = rotorid()
+        .args(["publish", rec, "--machine", "rig-9", "--nats", &url])
+        .args(["--replicas", "3"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success()
+            && err.contains("stream ROTORID_RAW has 1 replica(s), fewer than --replicas 3")
+            && err.contains("`rotorid fleet replicas 3 --nats"),
+        "{err}"
+    );
+    // refusals: a bad list, a replica count out of range, more replicas than servers (a
+    // server of its own: no stream yet)
+    let other = Server::start(&dir.path().join("js2"));
+    let fresh = other.url();
+    for (args, want) in [
+        (
+            vec!["--nats", "nats://127.0.0.1:99999"],
+            "NATS server \"nats://127.0.0.1:99999\": NATS server URL is invalid: invalid port",
+        ),
+        (
+            vec!["--nats", "nats://127.0.0.1:1,,nats://127.0.0.1:2"],
+            "an empty item",
+        ),
+        (
+            vec!["--nats", url.as_str(), "--replicas", "0"],
+            "--replicas: replicas = 0 is out of range: 1 ..= 5",
+        ),
+        (
+            vec!["--nats", fresh.as_str(), "--replicas", "3"],
+            "replicas = 3: the NATS servers refuse stream ROTORID_RAW with 3 replicas",
+        ),
+    ] {
+        let out = rotorid()
+            .args(["publish", rec, "--machine", "rig-8"])
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?}");
+        assert!(err.contains(want), "{args:?}: {err}");
+    }
+}

@@ -15,6 +15,7 @@ mod fe_data;
 mod fe_raw_identify;
 mod finite_element;
 mod fleet;
+mod fleet_cluster;
 mod formats;
 mod golden;
 mod identify;
