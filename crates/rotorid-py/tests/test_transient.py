@@ -414,11 +414,9 @@ def test_runup_apparent_peaks_lie_above_the_steady_state(runup, ref):
 
 def test_runup_modes(runup, ref):
     """Fitted modes: within 0.5 % in speed and 20 % in damping ratio of
-    the rotor's modes, each with a standard deviation. Skipped while transient.json has no
-    modes."""
-    modes = runup.json.get("modes")
-    if not modes:
-        pytest.skip("transient.json has no modes[]: the transient mode fit is not built yet")
+    the rotor's modes, each with a standard deviation, fitted on the transient response."""
+    modes = runup.json["modes"]
+    assert runup.json["mode_fit"]["basis"] == "transient", runup.json["mode_fit"]
     modes = sorted(modes, key=lambda m: m["rpm"])
     assert len(modes) == 2, modes
     for m, (n, zeta) in zip(modes, ref["modes"]):
@@ -557,6 +555,14 @@ def test_python_runup_criticals_match_the_steady_state(cache, ref):
             assert k["separation_margin_pct"] == pytest.approx(actual, abs=1e-9)
             assert k["required_margin_pct"] == pytest.approx(required, abs=1e-9)
             assert bool(k["margin_ok"]) is ok
+    # the fitted modes as a DataFrame: the rows of modes[], against the rotor's modes
+    modes = tr.modes
+    assert list(modes.columns) == ["rpm", "rpm_std", "damping_ratio", "damping_ratio_std",
+                                   "log_decrement", "log_decrement_std"]
+    assert modes.to_dict("records") == tr.to_dict()["modes"]
+    assert tr.mode_fit["basis"] == "transient"
+    for (_, m), (n, zeta) in zip(modes.sort_values("rpm").iterrows(), ref["modes"]):
+        assert abs(m["rpm"] / n - 1) <= 0.005 and abs(m["damping_ratio"] / zeta - 1) <= 0.20, (m, n, zeta)
 
 
 def test_python_options_equal_the_cli(cli, cache, tmp_path):

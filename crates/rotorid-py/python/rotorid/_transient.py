@@ -81,6 +81,17 @@ def _slow_roll(value: Any) -> tuple[str, Any]:
     )
 
 
+#: The columns of :attr:`Transient.modes`: ``transient.json``'s ``modes[]`` fields.
+MODE_COLUMNS = [
+    "rpm",
+    "rpm_std",
+    "damping_ratio",
+    "damping_ratio_std",
+    "log_decrement",
+    "log_decrement_std",
+]
+
+
 class Transient:
     """A run-up or coast-down analysed (``rotorid.transient``); ``to_dict()`` equals the
     ``transient.json`` of ``rotorid transient`` on the same input (``figures`` empty).
@@ -157,6 +168,18 @@ class Transient:
             else:
                 data[k] = vals
         return pd.DataFrame(data, columns=CRITICAL_COLUMNS)
+
+    @property
+    def modes(self) -> pd.DataFrame:
+        rows = self._d.get("modes") or []
+        return pd.DataFrame(
+            {k: np.array([np.nan if r.get(k) is None else float(r[k]) for r in rows], dtype=float) for k in MODE_COLUMNS},
+            columns=MODE_COLUMNS,
+        )
+
+    @property
+    def mode_fit(self) -> dict[str, Any] | None:
+        return self._d.get("mode_fit")
 
     def __repr__(self) -> str:
         lo, hi = self._d["speed_rpm"]

@@ -9,6 +9,8 @@ CRITICAL_COLUMNS: list[str]
 Records = str | os.PathLike[str] | Sequence[str | os.PathLike[str]]
 VectorTable = pd.DataFrame | Mapping[str, Any] | str | os.PathLike[str]
 
+MODE_COLUMNS: list[str]
+
 class Transient:
     """A run-up or coast-down analysed; ``to_dict()`` equals ``transient.json`` of
     ``rotorid transient`` on the same input (``figures`` empty)."""
@@ -33,6 +35,13 @@ class Transient:
     @property
     def criticals(self) -> pd.DataFrame:
         """One row per critical with the fields of ``transient.json``'s ``criticals[]``."""
+    @property
+    def modes(self) -> pd.DataFrame:
+        """One row per fitted mode (``MODE_COLUMNS``: natural speed rpm, damping ratio, log
+        decrement, each with its std), from ``transient.json``'s ``modes[]``."""
+    @property
+    def mode_fit(self) -> dict[str, Any] | None:
+        """How the modes were fitted (basis, sensors, window, adequacy, BIC candidates)."""
 
 def transient(
     records: Records | None = None,

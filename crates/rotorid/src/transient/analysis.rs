@@ -698,7 +698,7 @@ pub struct TableRow {
 }
 
 /// The analysis of a 1X table's `rows` (read from `source`), taken as compensated
-/// (docs/transient.md section 6): each sensor's speed checked, its criticals with their
+/// (docs/transient.md section 7): each sensor's speed checked, its criticals with their
 /// margins from `settings` (orders and bins do not apply).
 pub fn analyse_table(
     source: &str,

@@ -1,4 +1,4 @@
-//! The export contract of a transient analysis (docs/transient.md section 7):
+//! The export contract of a transient analysis (docs/transient.md section 8):
 //! `transient.json` as one serde model ([`TransientJson`], the same document from the
 //! `rotorid transient` command and from the Python package's `to_dict()`), and the rows of
 //! `bode.csv` ([`bode_rows`], in the file's order, in SI). Writing the files is the

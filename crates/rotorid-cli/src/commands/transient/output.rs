@@ -1,5 +1,5 @@
 //! The files of `rotorid transient`: `bode.csv`, `transient.json` (the export contract,
-//! docs/transient.md section 7, whose model and rows are the library's
+//! docs/transient.md section 8, whose model and rows are the library's
 //! `rotorid::transient::report`) and `report.html`.
 
 use std::io::Write as _;
