@@ -207,6 +207,20 @@ pub async fn start(shared: Arc<Shared>, url: String, raw_backfill: u64) {
         let on = rotorid_fleet::nats::describe_server(&client.server_info());
         shared.set_connected(true, Some(on));
     }
+    // The Connected event can come before the client has the new server's INFO (it then
+    // named the server just lost): the server shown follows the client's INFO every second.
+    {
+        let (s, c) = (Arc::clone(&shared), client.clone());
+        tokio::spawn(async move {
+            loop {
+                tokio::time::sleep(Duration::from_secs(1)).await;
+                if c.connection_state() == async_nats::connection::State::Connected {
+                    let on = rotorid_fleet::nats::describe_server(&c.server_info());
+                    s.set_connected(true, Some(on));
+                }
+            }
+        });
+    }
     let mut js = jetstream::new(client.clone());
     js.set_timeout(Duration::from_secs(5));
     *shared.js.lock().expect("not poisoned") = Some(js.clone());
