@@ -14,11 +14,11 @@
 //! The events are therefore corrected, then smoothed:
 //!
 //! - Sampling phase: each event's time residual against a wide smoothing (below) is
-//!   regressed on the first [`PHASE_HARMONICS`] harmonics of its sampling phase, each
-//!   times 1, w and w^2 (the edge's length in samples changes with the speed w), and the
-//!   harmonics' share is subtracted from the event's time. The residual fell from 46 to
-//!   11 us on the run-ups above, and what is left is far less correlated from event to
-//!   event. Only for evenly sampled records with enough events (10 per unknown).
+//!   regressed on a periodic piecewise-linear function of its sampling phase
+//!   ([`PHASE_KNOTS`] knots), each knot's value a quadratic in the speed w (the edge's
+//!   length in samples changes with w), and that function less its mean over the phase
+//!   is subtracted from the event's time. What is left is far less correlated from event
+//!   to event. Only for evenly sampled records with enough events (10 per unknown).
 //! - Smoothing: the speed of a run-up changes smoothly. Around an event k the angle
 //!   2 pi j of the events j = k - h .. k + h is fitted by a cubic in time, and the event's
 //!   time and speed are read from that cubic where it passes 2 pi k. This is done at every
@@ -216,10 +216,10 @@ fn even_step(t: &[f64]) -> Option<f64> {
 
 /// `ev` with the part of each event's timing error that depends on where the event falls
 /// between two samples removed (module doc): its time residual against `nodes` regressed
-/// on the first [`PHASE_HARMONICS`] harmonics of its sampling phase (t - t0) / dt mod 1,
-/// each times 1, w and w^2 (the edge's width in samples changes with the speed w), with a
-/// quadratic in w beside them; the harmonics' share subtracted. `None` with too few
-/// events for the regression (10 per unknown) or when it is singular.
+/// on periodic hat functions of its sampling phase (t - t0) / dt mod 1, each times 1, w
+/// and w^2 (w / its mean); their share less its mean over the phase subtracted. `None`
+/// with fewer than 4 knots' worth of events (30 per knot) or when the regression is
+/// singular or the corrected times are not increasing.
 fn sampling_phase_corrected(
     ev: &[(f64, f64)],
     nodes: &[Node],
