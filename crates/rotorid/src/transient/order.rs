@@ -193,12 +193,31 @@ pub fn track(
     signal: &[f64],
     settings: &OrderSettings,
 ) -> Result<Tracked, TransientError> {
+    let mut one = track_signals(t, psi, &[signal], settings)?;
+    Ok(one.pop().expect("one signal tracked"))
+}
+
+/// Track each of `signals` (the probes of one record: each the same length as `t` and
+/// `psi`) per revolution, as [`track`] does one, with the same results bit for bit. The
+/// regressors of a revolution, its normal equations and their factorisation depend on
+/// the angle alone, so they are computed once for all the signals, and the regressors once
+/// per sample instead of twice per signal.
+pub fn track_signals(
+    t: &[f64],
+    psi: &[f64],
+    signals: &[&[f64]],
+    settings: &OrderSettings,
+) -> Result<Vec<Tracked>, TransientError> {
     settings.validate()?;
     same_length("psi", psi.len(), "t", t.len())?;
-    same_length("signal", signal.len(), "t", t.len())?;
+    for s in signals {
+        same_length("signal", s.len(), "t", t.len())?;
+    }
     check_finite("t", t)?;
     check_finite("psi", psi)?;
-    check_finite("signal", signal)?;
+    for s in signals {
+        check_finite("signal", s)?;
+    }
     let top = settings.max_order() as usize;
     let wanted = settings.harmonics.max(top);
     let revs = revolutions(t, psi);
@@ -209,8 +228,12 @@ pub fn track(
             needed: 2,
         });
     }
-    let mut fits = Vec::with_capacity(revs.len());
-    let mut fit = RevolutionFit::default();
+    let mut shared = Vec::with_capacity(revs.len());
+    let mut fits: Vec<Vec<SignalFit>> = signals
+        .iter()
+        .map(|_| Vec::with_capacity(revs.len()))
+        .collect();
+    let mut normal = Normal::default();
     for (k, (range, t0, _)) in revs.iter().enumerate() {
         let n = range.len();
         // unknowns p = 1 + 2 H, at least as many residual degrees of freedom as unknowns
@@ -224,29 +247,47 @@ pub fn track(
                 needed: 2 * (1 + 2 * top),
             });
         }
-        fits.push(fit.fit(&psi[range.clone()], &signal[range.clone()], h, k, *t0)?);
+        shared.push(normal.build(&psi[range.clone()], h, &settings.orders, k, *t0)?);
+        for (s, out) in signals.iter().zip(&mut fits) {
+            out.push(normal.fit(&s[range.clone()]));
+        }
     }
-    // the gap's drift per revolution from the neighbours' constants, and its effect on
-    // each revolution's coefficients removed (module doc)
+    Ok(fits
+        .into_iter()
+        .map(|f| finish(&revs, &shared, f, settings))
+        .collect())
+}
+
+/// One signal's revolutions from their fits: the gap's drift per revolution from the
+/// neighbours' constants, and its effect on each revolution's coefficients removed (module
+/// doc); the vectors, their standard deviations, the speeds smoothed.
+fn finish(
+    revs: &[(std::ops::Range<usize>, f64, f64)],
+    shared: &[RevolutionFit],
+    fits: Vec<SignalFit>,
+    settings: &OrderSettings,
+) -> Tracked {
     let c: Vec<f64> = fits.iter().map(|f| f.theta[0]).collect();
     let m = c.len();
     let mut out = Vec::with_capacity(m);
-    for (k, ((_, t0, t1), f)) in revs.into_iter().zip(fits).enumerate() {
+    for (k, (((_, t0, t1), r), f)) in revs.iter().zip(shared).zip(fits).enumerate() {
+        let (t0, t1) = (*t0, *t1);
         let d = match k {
             0 => c[1] - c[0],
             _ if k == m - 1 => c[m - 1] - c[m - 2],
             _ => 0.5 * (c[k + 1] - c[k - 1]),
         };
-        let theta: Vec<f64> = f.theta.iter().zip(&f.g).map(|(th, g)| th - d * g).collect();
-        let rss = (f.rss - 2.0 * d * f.eu + d * d * f.uu).max(0.0);
-        let sigma2 = rss / (f.n - f.p) as f64;
+        let theta: Vec<f64> = f.theta.iter().zip(&r.g).map(|(th, g)| th - d * g).collect();
+        let rss = (f.rss - 2.0 * d * f.eu + d * d * r.uu).max(0.0);
+        let sigma2 = rss / (r.n - r.p) as f64;
         let (vectors, std) = settings
             .orders
             .iter()
-            .map(|&o| {
+            .zip(&r.inv_diag)
+            .map(|(&o, &(ia, ib))| {
                 let j = o as usize;
                 let (a, b) = (theta[2 * j - 1], theta[2 * j]);
-                let var = 0.5 * sigma2 * (f.inv_diag[2 * j - 1] + f.inv_diag[2 * j]);
+                let var = 0.5 * sigma2 * (ia + ib);
                 (C64::new(a, -b), var.max(0.0).sqrt())
             })
             .unzip();
@@ -255,17 +296,17 @@ pub fn track(
             t_end: t1,
             speed: TAU / (t1 - t0),
             dc: theta[0],
-            noise: (rss / f.n as f64).sqrt(),
+            noise: (rss / r.n as f64).sqrt(),
             vectors,
             std,
             count: 1,
         });
     }
     smooth_speeds(&mut out);
-    Ok(Tracked {
+    Tracked {
         orders: settings.orders.clone(),
         revolutions: out,
-    })
+    }
 }
 
 /// Revolutions on each side of one whose speeds smooth its own.
@@ -306,78 +347,96 @@ fn smooth_speeds(revs: &mut [Revolution]) {
     }
 }
 
-/// The least squares of one revolution.
+/// The least squares of one revolution, the part common to every signal: the regressors
+/// of each sample, the normal matrix A^T A factorised, and what a drift d u
+/// (u = (psi - psi_m) / 2 pi) changes (module doc). Its buffers are reused from one
+/// revolution to the next.
 #[derive(Default)]
-struct RevolutionFit {
-    row: Vec<f64>,
+struct Normal {
+    /// The regressors (1, cos psi, sin psi, ..., cos H psi, sin H psi) of each sample,
+    /// row after row.
+    rows: Vec<f64>,
+    /// psi - psi_m of each sample (u times 2 pi).
+    dpsi: Vec<f64>,
+    /// The upper triangle of A^T A, row-major p x p.
+    ata: Vec<f64>,
+    /// Unknowns of the current revolution.
+    p: usize,
+    /// The factorisation of the current revolution's A^T A.
+    chol: Option<nalgebra::linalg::Cholesky<f64, nalgebra::Dyn>>,
+    /// Scratch for one signal's A^T (s - s_0).
+    atb: Vec<f64>,
 }
 
-/// One revolution's fit without drift: coefficients (c, a_1, b_1, ..., a_H, b_H), the
-/// diagonal of (A^T A)^-1, the residual sum of squares, and what removing a drift
-/// d u (u = (psi - psi_m) / 2 pi) changes: g = (A^T A)^-1 A^T u (the coefficients move
-/// by -d g), e.u with e the residual, and |u - A g|^2.
-struct FitResult {
-    theta: Vec<f64>,
-    inv_diag: Vec<f64>,
-    rss: f64,
+/// A revolution's fit without drift, the part common to every signal: g = (A^T A)^-1
+/// A^T u (a drift d moves the coefficients by -d g), |u - A g|^2, the diagonal of
+/// (A^T A)^-1 at (a_n, b_n) of each order, N and p.
+struct RevolutionFit {
     g: Vec<f64>,
-    eu: f64,
     uu: f64,
+    inv_diag: Vec<(f64, f64)>,
     n: usize,
     p: usize,
 }
 
-impl RevolutionFit {
-    /// The regressors of angle `p` (module doc) into `self.row`.
-    fn regressors(&mut self, p: f64, h: usize) {
-        self.row.clear();
-        self.row.push(1.0);
-        let (s1, c1) = p.sin_cos();
-        let base = C64::new(c1, s1);
-        let mut e = base;
-        for _ in 0..h {
-            self.row.push(e.re);
-            self.row.push(e.im);
-            e *= base;
-        }
-    }
+/// A revolution's fit of one signal without drift: the coefficients
+/// (c, a_1, b_1, ..., a_H, b_H), the residual sum of squares, and e.u with e the residual.
+struct SignalFit {
+    theta: Vec<f64>,
+    rss: f64,
+    eu: f64,
+}
 
-    fn fit(
+impl Normal {
+    /// The regressors, normal equations and factorisation of the revolution with angles
+    /// `psi` and `h` harmonics; `orders` the orders whose variances are wanted; `k`, `t0`
+    /// name the revolution in an error.
+    fn build(
         &mut self,
         psi: &[f64],
-        s: &[f64],
         h: usize,
+        orders: &[u32],
         k: usize,
         t0: f64,
-    ) -> Result<FitResult, TransientError> {
+    ) -> Result<RevolutionFit, TransientError> {
         let p = 1 + 2 * h;
-        let n = s.len();
+        let n = psi.len();
+        self.p = p;
         let mid = 0.5 * (psi[0] + psi[n - 1]);
-        // the signal about its first sample, so the sums of squares keep their digits
-        let s0 = s[0];
-        let mut ata = DMatrix::<f64>::zeros(p, p);
-        let mut atb = DVector::<f64>::zeros(p);
+        self.rows.clear();
+        self.dpsi.clear();
+        self.ata.clear();
+        self.ata.resize(p * p, 0.0);
         let mut atu = DVector::<f64>::zeros(p);
         let mut uu = 0.0;
-        for (&pk, &sk) in psi.iter().zip(s) {
-            self.regressors(pk, h);
-            let y = sk - s0;
+        for &pk in psi {
+            let start = self.rows.len();
+            self.rows.push(1.0);
+            let (s1, c1) = pk.sin_cos();
+            let base = C64::new(c1, s1);
+            let mut e = base;
+            for _ in 0..h {
+                self.rows.push(e.re);
+                self.rows.push(e.im);
+                e *= base;
+            }
+            let row = &self.rows[start..];
             let u = (pk - mid) / TAU;
+            self.dpsi.push(pk - mid);
             uu += u * u;
             for i in 0..p {
-                let ri = self.row[i];
-                atb[i] += ri * y;
+                let ri = row[i];
                 atu[i] += ri * u;
-                for j in i..p {
-                    ata[(i, j)] += ri * self.row[j];
+                // each entry summed over the samples in their order, as a plain loop does
+                for (a, &rj) in self.ata[i * p + i..(i + 1) * p].iter_mut().zip(&row[i..]) {
+                    *a += ri * rj;
                 }
             }
         }
-        for i in 0..p {
-            for j in 0..i {
-                ata[(i, j)] = ata[(j, i)];
-            }
-        }
+        let ata = DMatrix::<f64>::from_fn(p, p, |i, j| {
+            let (i, j) = if i <= j { (i, j) } else { (j, i) };
+            self.ata[i * p + j]
+        });
         let chol = ata
             .cholesky()
             .ok_or(TransientError::TooFewSamplesPerRevolution {
@@ -387,29 +446,66 @@ impl RevolutionFit {
                 order: h as u32,
                 needed: 2 * p,
             })?;
-        let mut theta = chol.solve(&atb);
         let g = chol.solve(&atu);
-        let mut rss = 0.0;
-        let mut eu = 0.0;
-        for (&pk, &sk) in psi.iter().zip(s) {
-            self.regressors(pk, h);
-            let f: f64 = self.row.iter().zip(theta.iter()).map(|(r, c)| r * c).sum();
-            let e = sk - s0 - f;
-            rss += e * e;
-            eu += e * (pk - mid) / TAU;
-        }
-        theta[0] += s0;
-        let inv = chol.inverse();
-        Ok(FitResult {
-            theta: theta.iter().copied().collect(),
-            inv_diag: (0..p).map(|i| inv[(i, i)]).collect(),
-            rss,
+        // the diagonal of (A^T A)^-1 where it is needed: column by column, as the whole
+        // inverse is computed
+        let inv = |i: usize| {
+            let mut e = DVector::<f64>::zeros(p);
+            e[i] = 1.0;
+            chol.solve_mut(&mut e);
+            e[i]
+        };
+        let inv_diag = orders
+            .iter()
+            .map(|&o| {
+                let j = o as usize;
+                (inv(2 * j - 1), inv(2 * j))
+            })
+            .collect();
+        let uu = uu - g.dot(&atu);
+        self.chol = Some(chol);
+        Ok(RevolutionFit {
             g: g.iter().copied().collect(),
-            eu,
-            uu: uu - g.dot(&atu),
+            uu,
+            inv_diag,
             n,
             p,
         })
+    }
+
+    /// The fit of the signal `s` over the revolution last built.
+    fn fit(&mut self, s: &[f64]) -> SignalFit {
+        let p = self.p;
+        let chol = self
+            .chol
+            .as_ref()
+            .expect("a revolution built before its fits");
+        // the signal about its first sample, so the sums of squares keep their digits
+        let s0 = s[0];
+        self.atb.clear();
+        self.atb.resize(p, 0.0);
+        for (row, &sk) in self.rows.chunks_exact(p).zip(s) {
+            let y = sk - s0;
+            for (a, &ri) in self.atb.iter_mut().zip(row) {
+                *a += ri * y;
+            }
+        }
+        let mut theta = DVector::from_column_slice(&self.atb);
+        chol.solve_mut(&mut theta);
+        let mut rss = 0.0;
+        let mut eu = 0.0;
+        for ((row, &sk), &dpsi) in self.rows.chunks_exact(p).zip(s).zip(&self.dpsi) {
+            let f: f64 = row.iter().zip(theta.iter()).map(|(r, c)| r * c).sum();
+            let e = sk - s0 - f;
+            rss += e * e;
+            eu += e * dpsi / TAU;
+        }
+        theta[0] += s0;
+        SignalFit {
+            theta: theta.iter().copied().collect(),
+            rss,
+            eu,
+        }
     }
 }
 
@@ -427,17 +523,17 @@ pub fn bin(tracked: &Tracked, width_rpm: f64) -> Result<Tracked, TransientError>
         .into());
     }
     let m = tracked.orders.len();
-    let mut keys: Vec<i64> = Vec::new();
+    // each bin's place in `groups` by its key: a narrow bin on a long record makes
+    // thousands of bins, and a search through them per revolution grew as their product
+    let mut index: std::collections::HashMap<i64, usize> = std::collections::HashMap::new();
     let mut groups: Vec<Vec<&Revolution>> = Vec::new();
     for r in &tracked.revolutions {
         let key = (r.rpm() / width_rpm).floor() as i64;
-        match keys.iter().position(|&k| k == key) {
-            Some(i) => groups[i].push(r),
-            None => {
-                keys.push(key);
-                groups.push(vec![r]);
-            }
-        }
+        let i = *index.entry(key).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[i].push(r);
     }
     let revolutions = groups
         .into_iter()

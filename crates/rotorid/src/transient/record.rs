@@ -12,10 +12,10 @@
 use serde::Serialize;
 
 use super::error::TransientError;
-use super::order::{track, OrderSettings, Tracked};
+use super::order::{track_signals, OrderSettings, Tracked};
 use crate::acquisition::{
     channels, keyphasor_times, shaft_angle, time_of, Acquisition, KeyphasorReport, Probe,
-    RawRecord, Which,
+    RawRecord, ShaftAngle, Which,
 };
 
 /// One probe's vectors.
@@ -55,27 +55,42 @@ pub fn track_record(
     let stamps = time_of(raw, acq, which)?;
     let (v, kp) = channels(raw, acq, &stamps, which)?;
     let (t, _) = keyphasor_times(stamps);
-    let sa = shaft_angle(&t, kp, &acq.keyphasor, which)?;
-    let psi: Vec<f64> = sa.phi.iter().map(|p| p - acq.keyphasor.angle).collect();
+    let ShaftAngle {
+        phi: mut psi,
+        omega,
+        report,
+        ..
+    } = shaft_angle(&t, kp, &acq.keyphasor, which)?;
+    // psi in place of phi, w' dropped: a record's column less of each held
+    for p in &mut psi {
+        *p -= acq.keyphasor.angle;
+    }
     // events timed between samples scatter the phase of single revolutions (super::angle)
     let psi = super::angle::smooth(&t, &psi);
-    let mut out = Vec::with_capacity(probes.len());
-    let mut displacement = Vec::with_capacity(probes.len());
-    for &k in probes {
-        let p = &acq.probes[k];
-        let d: Vec<f64> = v[k].iter().map(|x| x / p.sensitivity).collect();
-        let tracked = track(&t, &psi, &d, settings)?;
-        out.push(ProbeTrack {
-            probe: p.clone(),
+    let displacement: Vec<Vec<f64>> = probes
+        .iter()
+        .map(|&k| {
+            let s = acq.probes[k].sensitivity;
+            v[k].iter().map(|x| x / s).collect()
+        })
+        .collect();
+    let signals: Vec<&[f64]> = displacement.iter().map(Vec::as_slice).collect();
+    // the probes tracked together: one set of normal equations per revolution for both
+    let tracked = track_signals(&t, &psi, &signals, settings)?;
+    drop(psi);
+    let out = probes
+        .iter()
+        .zip(tracked)
+        .map(|(&k, tracked)| ProbeTrack {
+            probe: acq.probes[k].clone(),
             tracked,
-        });
-        displacement.push(d);
-    }
+        })
+        .collect();
     Ok(RecordTrack {
-        keyphasor: sa.report,
+        keyphasor: report,
         probes: out,
         t,
-        omega: sa.omega,
+        omega,
         displacement,
     })
 }
