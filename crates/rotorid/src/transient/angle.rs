@@ -79,12 +79,21 @@ fn smoothed_event(ev: &[(f64, f64)], k: usize) -> Option<(f64, f64)> {
 /// 2 pi at each smoothed event. Unchanged with fewer than 5 events or where a fit fails
 /// (then that stretch keeps the measured angle).
 pub fn smooth(t: &[f64], psi: &[f64]) -> Vec<f64> {
+    let mut out = psi.to_vec();
+    smooth_in_place(t, &mut out);
+    out
+}
+
+/// [`smooth`] in place: `psi` becomes the smoothed angle (no second copy of the record's
+/// angle). The same values: each sample's new angle depends on the events, found before
+/// anything is changed, and on its own time.
+pub fn smooth_in_place(t: &[f64], psi: &mut [f64]) {
     let ev = events(t, psi);
     if ev.len() < 5 || t.len() != psi.len() {
-        return psi.to_vec();
+        return;
     }
     let smooth: Vec<Option<(f64, f64)>> = (0..ev.len()).map(|k| smoothed_event(&ev, k)).collect();
-    let mut out = psi.to_vec();
+    let out = psi;
     // the samples between consecutive events, by the measured angle
     let mut j = 0;
     for (i, o) in out.iter_mut().enumerate() {
@@ -117,7 +126,6 @@ pub fn smooth(t: &[f64], psi: &[f64]) -> Vec<f64> {
             out[i] = out[i - 1];
         }
     }
-    out
 }
 
 #[cfg(test)]

@@ -275,6 +275,46 @@ pub fn full_cascade(
     check_finite("x", x)?;
     check_finite("z", z)?;
     let plan = Plan::new(t, omega, settings)?;
+    Ok(full_spectra(plan, |s, n| (x[s..s + n].to_vec(), z[s..s + n].to_vec())))
+}
+
+/// [`full_cascade`] of the x and z of an XY probe pair, from the displacements `d1`, `d2`
+/// \[m\] of its two probes and the inverse of their projection `inv`
+/// (`acquisition::probes::inverse_projection`): (x, z) = inv (d1, d2) at each sample of
+/// the blocks, computed block by block instead of for the whole record first (the same
+/// values: the same product at each sample).
+///
+/// # Errors
+///
+/// As [`cascade`] (`probe 1`, `probe 2` for the displacements).
+pub fn full_cascade_of_pair(
+    t: &[f64],
+    omega: &[f64],
+    d1: &[f64],
+    d2: &[f64],
+    inv: &nalgebra::Matrix2<f64>,
+    settings: &CascadeSettings,
+) -> Result<Cascade, TransientError> {
+    same_length("probe 1", d1.len(), "t", t.len())?;
+    same_length("probe 2", d2.len(), "t", t.len())?;
+    check_finite("probe 1", d1)?;
+    check_finite("probe 2", d2)?;
+    let plan = Plan::new(t, omega, settings)?;
+    Ok(full_spectra(plan, |s, n| {
+        d1[s..s + n]
+            .iter()
+            .zip(&d2[s..s + n])
+            .map(|(&a, &b)| {
+                let q = inv * nalgebra::Vector2::new(a, b);
+                (q[0], q[1])
+            })
+            .unzip()
+    }))
+}
+
+/// The full spectra of the blocks of `plan`, `block(start, n)` giving the x and z of the
+/// block of `n` samples from `start`.
+fn full_spectra(plan: Plan, mut block: impl FnMut(usize, usize) -> (Vec<f64>, Vec<f64>)) -> Cascade {
     let n = plan.n;
     let kmax = plan.kmax.min(n / 2 - 1);
     let s1 = 0.5 * n as f64;
@@ -284,8 +324,9 @@ pub fn full_cascade(
         .starts
         .iter()
         .map(|&s| {
-            let zs = fft.spectrum(&z[s..s + n]).to_vec();
-            let xs = fft.spectrum(&x[s..s + n]);
+            let (x, z) = block(s, n);
+            let zs = fft.spectrum(&z).to_vec();
+            let xs = fft.spectrum(&x);
             // P = DFT(z + i x): P[k] = Z[k] + i X[k], P[-k] = conj(Z[k]) + i conj(X[k]).
             let backward = (1..=kmax)
                 .rev()
@@ -295,14 +336,14 @@ pub fn full_cascade(
         })
         .collect();
     let kmax = kmax as i64;
-    Ok(Cascade {
+    Cascade {
         rpm: plan.rpm,
         t: plan.t,
         freq_hz: (-kmax..=kmax).map(|k| k as f64 * plan.df).collect(),
         amplitude,
         lines: n,
         full: true,
-    })
+    }
 }
 
 /// Where the blocks go and what they are tagged with.
