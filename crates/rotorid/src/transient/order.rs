@@ -351,21 +351,32 @@ fn smooth_speeds(revs: &mut [Revolution]) {
 /// of each sample, the normal matrix A^T A factorised, and what a drift d u
 /// (u = (psi - psi_m) / 2 pi) changes (module doc). Its buffers are reused from one
 /// revolution to the next.
+///
+/// The regressors are kept column by column (each harmonic's cos and sin over the
+/// samples), so that every sum over the samples is a dot product of two contiguous
+/// columns. A^T A is not summed entry by entry (p (p + 1) / 2 = 153 products a sample for
+/// H = 8): its entries are sums of products of harmonics, which are harmonics again,
+/// `cos a cos b = (cos (a - b) + cos (a + b)) / 2` and the like, so it is assembled from
+/// the 2 (2 H) + 1 sums of cos(m psi) and sin(m psi), m = 0 .. 2 H ([`normal_from_sums`]).
+/// The same matrix to rounding (each entry is now a sum of two rounded sums instead of one
+/// sum of rounded products): the coefficients move by a few units of their last digits.
 #[derive(Default)]
 struct Normal {
-    /// The regressors (1, cos psi, sin psi, ..., cos H psi, sin H psi) of each sample,
-    /// row after row.
-    rows: Vec<f64>,
-    /// psi - psi_m of each sample (u times 2 pi).
-    dpsi: Vec<f64>,
-    /// The upper triangle of A^T A, row-major p x p.
-    ata: Vec<f64>,
+    /// The columns cos(psi), sin(psi), ..., cos(H psi), sin(H psi), each of the
+    /// revolution's samples, one after the other (2 H n values).
+    cols: Vec<f64>,
+    /// u = (psi - psi_m) / 2 pi of each sample.
+    u: Vec<f64>,
+    /// Scratch: cos(m psi), sin(m psi) for m > H (their sums only are needed).
+    high: [Vec<f64>; 2],
+    /// Scratch: one signal about its first sample, then its residuals.
+    y: Vec<f64>,
+    /// Samples of the current revolution.
+    n: usize,
     /// Unknowns of the current revolution.
     p: usize,
     /// The factorisation of the current revolution's A^T A.
     chol: Option<nalgebra::linalg::Cholesky<f64, nalgebra::Dyn>>,
-    /// Scratch for one signal's A^T (s - s_0).
-    atb: Vec<f64>,
 }
 
 /// A revolution's fit without drift, the part common to every signal: g = (A^T A)^-1
@@ -387,7 +398,98 @@ struct SignalFit {
     eu: f64,
 }
 
+/// Sum of `a` (four running sums, so that the additions of neighbouring samples do not
+/// wait for each other and can go two or four at a time).
+#[inline]
+fn sum(a: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let mut chunks = a.chunks_exact(4);
+    for c in &mut chunks {
+        for l in 0..4 {
+            acc[l] += c[l];
+        }
+    }
+    let tail: f64 = chunks.remainder().iter().sum();
+    (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
+}
+
+/// The dot product of `a` and `b` (same length), four running sums as [`sum`].
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let mut ca = a.chunks_exact(4);
+    let mut cb = b.chunks_exact(4);
+    for (x, y) in (&mut ca).zip(&mut cb) {
+        for l in 0..4 {
+            acc[l] += x[l] * y[l];
+        }
+    }
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
+}
+
+/// cos(m psi), sin(m psi) of each sample from those of (m - 1) psi and psi: one complex
+/// multiplication a sample, as the rows were built before.
+#[inline]
+fn next_harmonic(prev: (&[f64], &[f64]), first: (&[f64], &[f64]), out: (&mut [f64], &mut [f64])) {
+    let (pc, ps) = prev;
+    let (c1, s1) = first;
+    let (oc, os) = out;
+    for k in 0..oc.len() {
+        let (a, b, c, d) = (pc[k], ps[k], c1[k], s1[k]);
+        oc[k] = a * c - b * d;
+        os[k] = a * d + b * c;
+    }
+}
+
+/// A^T A (p x p, p = 1 + 2 h; regressors 1, cos psi, sin psi, ..., cos h psi, sin h psi)
+/// from the sums `c[m]` of cos(m psi) and `s[m]` of sin(m psi) over the samples,
+/// m = 0 .. 2 h (c\[0\] the count, s\[0\] = 0): with C_-m = C_m and S_-m = -S_m,
+///
+/// ```text
+/// sum cos(a psi) cos(b psi) = (C_(a-b) + C_(a+b)) / 2
+/// sum sin(a psi) sin(b psi) = (C_(a-b) - C_(a+b)) / 2
+/// sum cos(a psi) sin(b psi) = (S_(a+b) - S_(a-b)) / 2
+/// ```
+fn normal_from_sums(c: &[f64], s: &[f64], h: usize) -> DMatrix<f64> {
+    let p = 1 + 2 * h;
+    let cm = |m: isize| c[m.unsigned_abs()];
+    let sm = |m: isize| if m < 0 { -s[m.unsigned_abs()] } else { s[m as usize] };
+    DMatrix::<f64>::from_fn(p, p, |i, j| {
+        // regressor i: 0 the constant, 2 a - 1 cos(a psi), 2 a sin(a psi)
+        let kind = |i: usize| -> (isize, bool) { (i.div_ceil(2) as isize, i % 2 == 0) };
+        if i == 0 && j == 0 {
+            return c[0];
+        }
+        if i == 0 || j == 0 {
+            let (m, sine) = kind(i.max(j));
+            return if sine { sm(m) } else { cm(m) };
+        }
+        let ((a, sa), (b, sb)) = (kind(i), kind(j));
+        match (sa, sb) {
+            (false, false) => 0.5 * (cm(a - b) + cm(a + b)),
+            (true, true) => 0.5 * (cm(a - b) - cm(a + b)),
+            // cos(a psi) sin(b psi)
+            (false, true) => 0.5 * (sm(a + b) - sm(a - b)),
+            (true, false) => 0.5 * (sm(a + b) - sm(b - a)),
+        }
+    })
+}
+
 impl Normal {
+    /// The column of cos(m psi) (`sine` false) or sin(m psi), m = 1 .. H.
+    fn col(&self, m: usize, sine: bool) -> &[f64] {
+        let at = (2 * (m - 1) + usize::from(sine)) * self.n;
+        &self.cols[at..at + self.n]
+    }
+
     /// The regressors, normal equations and factorisation of the revolution with angles
     /// `psi` and `h` harmonics; `orders` the orders whose variances are wanted; `k`, `t0`
     /// name the revolution in an error.
@@ -402,41 +504,61 @@ impl Normal {
         let p = 1 + 2 * h;
         let n = psi.len();
         self.p = p;
+        self.n = n;
         let mid = 0.5 * (psi[0] + psi[n - 1]);
-        self.rows.clear();
-        self.dpsi.clear();
-        self.ata.clear();
-        self.ata.resize(p * p, 0.0);
-        let mut atu = DVector::<f64>::zeros(p);
-        let mut uu = 0.0;
-        for &pk in psi {
-            let start = self.rows.len();
-            self.rows.push(1.0);
-            let (s1, c1) = pk.sin_cos();
-            let base = C64::new(c1, s1);
-            let mut e = base;
-            for _ in 0..h {
-                self.rows.push(e.re);
-                self.rows.push(e.im);
-                e *= base;
-            }
-            let row = &self.rows[start..];
-            let u = (pk - mid) / TAU;
-            self.dpsi.push(pk - mid);
-            uu += u * u;
-            for i in 0..p {
-                let ri = row[i];
-                atu[i] += ri * u;
-                // each entry summed over the samples in their order, as a plain loop does
-                for (a, &rj) in self.ata[i * p + i..(i + 1) * p].iter_mut().zip(&row[i..]) {
-                    *a += ri * rj;
-                }
+        self.u.clear();
+        self.u.extend(psi.iter().map(|&pk| (pk - mid) / TAU));
+        self.cols.clear();
+        self.cols.resize(2 * h * n, 0.0);
+        {
+            let (c1, rest) = self.cols.split_at_mut(n);
+            for ((c, s), &pk) in c1.iter_mut().zip(&mut rest[..n]).zip(psi) {
+                (*s, *c) = pk.sin_cos();
             }
         }
-        let ata = DMatrix::<f64>::from_fn(p, p, |i, j| {
-            let (i, j) = if i <= j { (i, j) } else { (j, i) };
-            self.ata[i * p + j]
-        });
+        // the sums of cos(m psi), sin(m psi), m = 0 .. 2 h
+        let mut cs = vec![0.0; 2 * h + 1];
+        let mut ss = vec![0.0; 2 * h + 1];
+        cs[0] = n as f64;
+        for m in 1..=h {
+            if m > 1 {
+                let (done, out) = self.cols.split_at_mut(2 * (m - 1) * n);
+                let (oc, os) = out[..2 * n].split_at_mut(n);
+                let first = (&done[..n], &done[n..2 * n]);
+                let prev = &done[2 * (m - 2) * n..];
+                next_harmonic((&prev[..n], &prev[n..2 * n]), first, (oc, os));
+            }
+            cs[m] = sum(self.col(m, false));
+            ss[m] = sum(self.col(m, true));
+        }
+        for m in h + 1..=2 * h {
+            let [hc, hs] = &mut self.high;
+            hc.resize(n, 0.0);
+            hs.resize(n, 0.0);
+            let first = (&self.cols[..n], &self.cols[n..2 * n]);
+            if m == h + 1 {
+                let at = 2 * (h - 1) * n;
+                let prev = (&self.cols[at..at + n], &self.cols[at + n..at + 2 * n]);
+                next_harmonic(prev, first, (&mut hc[..], &mut hs[..]));
+            } else {
+                // in place: each sample's new value depends on its own old one only
+                for k in 0..n {
+                    let (a, b, c, d) = (hc[k], hs[k], first.0[k], first.1[k]);
+                    hc[k] = a * c - b * d;
+                    hs[k] = a * d + b * c;
+                }
+            }
+            cs[m] = sum(&hc[..]);
+            ss[m] = sum(&hs[..]);
+        }
+        let ata = normal_from_sums(&cs, &ss, h);
+        let mut atu = DVector::<f64>::zeros(p);
+        atu[0] = sum(&self.u);
+        for m in 1..=h {
+            atu[2 * m - 1] = dot(self.col(m, false), &self.u);
+            atu[2 * m] = dot(self.col(m, true), &self.u);
+        }
+        let uu = dot(&self.u, &self.u);
         let chol = ata
             .cholesky()
             .ok_or(TransientError::TooFewSamplesPerRevolution {
@@ -475,31 +597,37 @@ impl Normal {
 
     /// The fit of the signal `s` over the revolution last built.
     fn fit(&mut self, s: &[f64]) -> SignalFit {
-        let p = self.p;
-        let chol = self
-            .chol
-            .as_ref()
-            .expect("a revolution built before its fits");
+        let (p, n) = (self.p, self.n);
+        let h = (p - 1) / 2;
         // the signal about its first sample, so the sums of squares keep their digits
         let s0 = s[0];
-        self.atb.clear();
-        self.atb.resize(p, 0.0);
-        for (row, &sk) in self.rows.chunks_exact(p).zip(s) {
-            let y = sk - s0;
-            for (a, &ri) in self.atb.iter_mut().zip(row) {
-                *a += ri * y;
+        let mut y = std::mem::take(&mut self.y);
+        y.clear();
+        y.extend(s[..n].iter().map(|&sk| sk - s0));
+        let mut theta = DVector::<f64>::zeros(p);
+        theta[0] = sum(&y);
+        for m in 1..=h {
+            theta[2 * m - 1] = dot(self.col(m, false), &y);
+            theta[2 * m] = dot(self.col(m, true), &y);
+        }
+        self.chol
+            .as_ref()
+            .expect("a revolution built before its fits")
+            .solve_mut(&mut theta);
+        // the residuals in place of y: e = y - c - sum a_m cos(m psi) + b_m sin(m psi)
+        let c = theta[0];
+        for v in y.iter_mut() {
+            *v -= c;
+        }
+        for m in 1..=h {
+            let (a, b) = (theta[2 * m - 1], theta[2 * m]);
+            for ((v, &cm), &sm) in y.iter_mut().zip(self.col(m, false)).zip(self.col(m, true)) {
+                *v -= a * cm + b * sm;
             }
         }
-        let mut theta = DVector::from_column_slice(&self.atb);
-        chol.solve_mut(&mut theta);
-        let mut rss = 0.0;
-        let mut eu = 0.0;
-        for ((row, &sk), &dpsi) in self.rows.chunks_exact(p).zip(s).zip(&self.dpsi) {
-            let f: f64 = row.iter().zip(theta.iter()).map(|(r, c)| r * c).sum();
-            let e = sk - s0 - f;
-            rss += e * e;
-            eu += e * dpsi / TAU;
-        }
+        let rss = dot(&y, &y);
+        let eu = dot(&y, &self.u);
+        self.y = y;
         theta[0] += s0;
         SignalFit {
             theta: theta.iter().copied().collect(),
@@ -581,6 +709,60 @@ mod tests {
         let t: Vec<f64> = (0..n).map(|i| i as f64 / fs).collect();
         let psi = t.iter().map(|&t| w0 * t + 0.5 * a * t * t).collect();
         (t, psi)
+    }
+
+    /// A^T A assembled from the sums of cos(m psi) and sin(m psi) is the sum of the
+    /// products of the regressors to rounding, and the fit of a revolution the least
+    /// squares solution of its samples (nalgebra's SVD of the whole design matrix).
+    #[test]
+    fn normal_equations_from_harmonic_sums_equal_the_products() {
+        let (_, psi) = run_up(40.0, 30.0, 2000.0, 3.0);
+        // one revolution from psi = 20 pi, unevenly spaced (a run-up)
+        let a = psi.iter().position(|&p| p >= 20.0 * std::f64::consts::PI).unwrap();
+        let b = psi.iter().position(|&p| p >= 22.0 * std::f64::consts::PI).unwrap();
+        let psi = &psi[a..b];
+        let h = 8;
+        let p = 1 + 2 * h;
+        let design = DMatrix::<f64>::from_fn(psi.len(), p, |k, j| match j {
+            0 => 1.0,
+            _ if j % 2 == 1 => (j.div_ceil(2) as f64 * psi[k]).cos(),
+            _ => ((j / 2) as f64 * psi[k]).sin(),
+        });
+        let direct = design.transpose() * &design;
+        let mut normal = super::Normal::default();
+        normal.build(psi, h, &[1, 2], 0, 0.0).unwrap();
+        let cs: Vec<f64> = (0..=2 * h)
+            .map(|m| psi.iter().map(|&x| (m as f64 * x).cos()).sum())
+            .collect();
+        let ss: Vec<f64> = (0..=2 * h)
+            .map(|m| psi.iter().map(|&x| (m as f64 * x).sin()).sum())
+            .collect();
+        let from_sums = normal_from_sums(&cs, &ss, h);
+        let scale = psi.len() as f64;
+        assert!(
+            (&from_sums - &direct).amax() < 1e-12 * scale,
+            "{}",
+            (&from_sums - &direct).amax()
+        );
+        // a signal of the model plus noise: the coefficients of the least squares
+        let mut rng = rand::rngs::StdRng::seed_from_u64(1);
+        let noise = Normal::new(0.0, 0.1).unwrap();
+        let y: Vec<f64> = psi
+            .iter()
+            .map(|&x| 3.0 + 2.0 * x.cos() - 0.5 * (2.0 * x).sin() + noise.sample(&mut rng))
+            .collect();
+        let fit = normal.fit(&y);
+        let ls = design
+            .clone()
+            .svd(true, true)
+            .solve(&DVector::from_column_slice(&y), 1e-14)
+            .unwrap();
+        for (j, (x, want)) in fit.theta.iter().zip(ls.iter()).enumerate() {
+            assert!((x - want).abs() < 1e-12, "coefficient {j}: {x} against {want}");
+        }
+        let resid = DVector::from_column_slice(&y) - &design * &ls;
+        let rss = resid.dot(&resid);
+        assert!((fit.rss / rss - 1.0).abs() < 1e-10, "{} against {rss}", fit.rss);
     }
 
     #[test]
