@@ -20,7 +20,7 @@ use super::error::TransientError;
 use super::modes::{self, fit_modes, FitBasis, ModeFit, ModeSettings, SensorSeries};
 use super::order::{bin, track, OrderSettings, Tracked, C64};
 use super::record::{track_record, track_record_owned, RecordTrack};
-use super::spectrum::{cascade, full_cascade_of_pair, Cascade, CascadeSettings};
+use super::spectrum::{record_cascades, Cascade, CascadeSettings};
 use super::slow_roll::{self, SlowRoll, SlowRollSource};
 use super::synchronous::Sweep;
 use crate::acquisition::{Acquisition, KeyphasorReport, Probe, RawRecord, Which};
@@ -262,18 +262,16 @@ impl Spectra {
         pair: Option<[f64; 2]>,
         settings: &CascadeSettings,
     ) -> Self {
-        let probes = displacement
-            .iter()
-            .map(|d| cascade(t, omega, d, settings))
-            .collect();
-        let full = match (pair, displacement) {
-            (Some(angles), [d1, d2]) => Some(
+        let signals: Vec<&[f64]> = displacement.iter().map(Vec::as_slice).collect();
+        let pair = match (pair, displacement) {
+            (Some(angles), [_, _]) => Some(
                 crate::acquisition::probes::inverse_projection(angles)
-                    .map_err(TransientError::from)
-                    .and_then(|inv| full_cascade_of_pair(t, omega, d1, d2, &inv, settings)),
+                    .map_err(TransientError::from),
             ),
             _ => None,
         };
+        // the blocks planned once for the record's cascades
+        let (probes, full) = record_cascades(t, omega, &signals, pair, settings);
         Self { probes, full }
     }
 }

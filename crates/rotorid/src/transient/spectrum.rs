@@ -226,6 +226,11 @@ pub fn cascade(
     same_length("signal", signal.len(), "t", t.len())?;
     check_finite("signal", signal)?;
     let plan = Plan::new(t, omega, settings)?;
+    Ok(spectra_of(plan, signal))
+}
+
+/// The cascade of `plan`'s blocks of `signal`.
+fn spectra_of(plan: Plan, signal: &[f64]) -> Cascade {
     let n = plan.n;
     let kmax = plan.kmax.min(n / 2);
     let s1 = 0.5 * n as f64; // sum of the window: the coherent gain times N
@@ -243,14 +248,74 @@ pub fn cascade(
                 .collect()
         })
         .collect();
-    Ok(Cascade {
+    Cascade {
         rpm: plan.rpm,
         t: plan.t,
         freq_hz: (0..=kmax).map(|k| k as f64 * plan.df).collect(),
         amplitude,
         lines: n,
         full: false,
-    })
+    }
+}
+
+/// The cascades of one record: [`cascade`] of each of `signals` and, with `pair` (the
+/// inverse of an XY pair's projection, the first two signals its probes),
+/// [`full_cascade_of_pair`], each with the result (or error) those functions give, but
+/// with the blocks planned once for all of them (the sampling's checks over every time
+/// step were made three times for a pair).
+pub fn record_cascades(
+    t: &[f64],
+    omega: &[f64],
+    signals: &[&[f64]],
+    pair: Option<Result<nalgebra::Matrix2<f64>, TransientError>>,
+    settings: &CascadeSettings,
+) -> (
+    Vec<Result<Cascade, TransientError>>,
+    Option<Result<Cascade, TransientError>>,
+) {
+    let mut plan = None;
+    let mut plan = || -> Result<Plan, TransientError> {
+        plan.get_or_insert_with(|| Plan::new(t, omega, settings))
+            .clone()
+    };
+    let probes = signals
+        .iter()
+        .map(|signal| {
+            same_length("signal", signal.len(), "t", t.len())?;
+            check_finite("signal", signal)?;
+            Ok(spectra_of(plan()?, signal))
+        })
+        .collect();
+    let full = match (pair, signals) {
+        (Some(inv), [d1, d2, ..]) => Some(inv.and_then(|inv| {
+            same_length("probe 1", d1.len(), "t", t.len())?;
+            same_length("probe 2", d2.len(), "t", t.len())?;
+            check_finite("probe 1", d1)?;
+            check_finite("probe 2", d2)?;
+            Ok(full_spectra(plan()?, pair_block(d1, d2, &inv)))
+        })),
+        _ => None,
+    };
+    (probes, full)
+}
+
+/// The x and z of the block of `n` samples from `s` of an XY pair's displacements `d1`,
+/// `d2` through the inverse of their projection `inv`.
+fn pair_block<'a>(
+    d1: &'a [f64],
+    d2: &'a [f64],
+    inv: &'a nalgebra::Matrix2<f64>,
+) -> impl FnMut(usize, usize) -> (Vec<f64>, Vec<f64>) + 'a {
+    move |s, n| {
+        d1[s..s + n]
+            .iter()
+            .zip(&d2[s..s + n])
+            .map(|(&a, &b)| {
+                let q = inv * nalgebra::Vector2::new(a, b);
+                (q[0], q[1])
+            })
+            .unzip()
+    }
 }
 
 /// The full spectra of the probe pair `x` (horizontal) and `z` (vertical, up) \[m\]
@@ -300,16 +365,7 @@ pub fn full_cascade_of_pair(
     check_finite("probe 1", d1)?;
     check_finite("probe 2", d2)?;
     let plan = Plan::new(t, omega, settings)?;
-    Ok(full_spectra(plan, |s, n| {
-        d1[s..s + n]
-            .iter()
-            .zip(&d2[s..s + n])
-            .map(|(&a, &b)| {
-                let q = inv * nalgebra::Vector2::new(a, b);
-                (q[0], q[1])
-            })
-            .unzip()
-    }))
+    Ok(full_spectra(plan, pair_block(d1, d2, inv)))
 }
 
 /// The full spectra of the blocks of `plan`, `block(start, n)` giving the x and z of the
@@ -347,6 +403,7 @@ fn full_spectra(plan: Plan, mut block: impl FnMut(usize, usize) -> (Vec<f64>, Ve
 }
 
 /// Where the blocks go and what they are tagged with.
+#[derive(Clone)]
 struct Plan {
     /// Block length \[samples\].
     n: usize,
