@@ -71,14 +71,33 @@ pub fn channels(
     time_column: Option<&str>,
     first_probe: &str,
 ) -> Result<RawChannels, RawError> {
+    let data = table.channels.iter().map(|c| c.data.clone()).collect();
+    convert(table, data, roles, time_column, first_probe)
+}
+
+/// [`channels`] of `table` whose samples are `data` (each channel's, in file order; the
+/// table's own may have been taken out of it), converted in place.
+fn convert(
+    table: &Table,
+    data: Vec<Vec<f64>>,
+    roles: &[(&str, &str)],
+    time_column: Option<&str>,
+    first_probe: &str,
+) -> Result<RawChannels, RawError> {
     let found: Vec<(&str, &str, Option<&str>)> = roles
         .iter()
         .map(|&(n, what)| (n, what, table.channel(n).map(|c| c.name.as_str())))
         .collect();
+    let probe = table.channel(first_probe);
+    let probe_len = table
+        .channels
+        .iter()
+        .zip(&data)
+        .find(|(c, _)| probe.is_some_and(|p| std::ptr::eq(*c, p)))
+        .map_or(0, |(_, d)| d.len());
     let mut columns = Vec::with_capacity(table.channels.len() + 1);
-    for c in &table.channels {
+    for (c, mut data) in table.channels.iter().zip(data) {
         let role = found.iter().find(|(_, _, f)| *f == Some(c.name.as_str()));
-        let mut data = c.data.clone();
         let name = match role {
             Some(&(name, what, _)) => {
                 let q = if what == "time" {
@@ -101,7 +120,6 @@ pub fn channels(
     }
     let mut notes = Vec::new();
     if let Some(t) = time_column {
-        let probe = table.channel(first_probe);
         if let (None, Some(axis), Some(probe)) =
             (table.channel(t), probe.and_then(|p| p.axis), probe)
         {
@@ -109,7 +127,7 @@ pub fn channels(
                 "time from the file's time axis of {:?} (no channel {t:?})",
                 probe.name
             ));
-            columns.push((t.to_owned(), axis.times(probe.data.len())));
+            columns.push((t.to_owned(), axis.times(probe_len)));
         }
     }
     Ok(RawChannels { columns, notes })
@@ -122,8 +140,14 @@ pub fn read(
     time_column: Option<&str>,
     first_probe: &str,
 ) -> Result<RawChannels, RawError> {
-    let table = crate::read_table(path)?;
-    let mut out = channels(&table, roles, time_column, first_probe)?;
+    let mut table = crate::read_table(path)?;
+    // the samples moved out of the table, not copied: one copy of the record held, not two
+    let data = table
+        .channels
+        .iter_mut()
+        .map(|c| std::mem::take(&mut c.data))
+        .collect();
+    let mut out = convert(&table, data, roles, time_column, first_probe)?;
     let mut notes = table.notes;
     notes.append(&mut out.notes);
     out.notes = notes;

@@ -122,6 +122,8 @@ pub fn transient(spec: Option<&ScenarioSpec>, r: &Request) -> Result<Outcome, Er
         },
         bin_rpm: r.bin_rpm,
         operating_rpm: r.operating_rpm,
+        // the package returns no cascade: not computed
+        cascade: None,
         ..Settings::default()
     };
     // the settings first, as the command's arguments are checked before any file is read

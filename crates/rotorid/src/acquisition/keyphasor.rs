@@ -111,13 +111,26 @@ struct Event {
 
 /// Median of a non-empty slice (copied).
 pub(crate) fn median(v: &[f64]) -> f64 {
-    let mut s: Vec<f64> = v.to_vec();
-    s.sort_by(|a, b| a.total_cmp(b));
+    median_in_place(&mut v.to_vec())
+}
+
+/// Median of a non-empty slice, reordering it: the middle element (the mean of the two
+/// middle ones for an even length) of the values ordered by `total_cmp`, as a full sort
+/// gives them, found by selection (linear, not n log n).
+pub(crate) fn median_in_place(s: &mut [f64]) -> f64 {
     let n = s.len();
+    let (lower, mid, _) = s.select_nth_unstable_by(n / 2, f64::total_cmp);
+    let mid = *mid;
     if n % 2 == 1 {
-        s[n / 2]
+        mid
     } else {
-        0.5 * (s[n / 2 - 1] + s[n / 2])
+        // the largest of the lower half: the element a sort puts at n / 2 - 1
+        let below = lower
+            .iter()
+            .copied()
+            .max_by(f64::total_cmp)
+            .expect("an even length >= 2 has a lower half");
+        0.5 * (below + mid)
     }
 }
 
@@ -126,10 +139,13 @@ pub(crate) fn noise_from_differences(v: &[f64]) -> f64 {
     if v.len() < 3 {
         return 0.0;
     }
-    let d: Vec<f64> = v.windows(2).map(|w| w[1] - w[0]).collect();
-    let med = median(&d);
-    let mad: Vec<f64> = d.iter().map(|x| (x - med).abs()).collect();
-    1.4826 * median(&mad) / 2f64.sqrt()
+    let mut d: Vec<f64> = v.windows(2).map(|w| w[1] - w[0]).collect();
+    let med = median_in_place(&mut d);
+    // the absolute deviations in the same buffer (their order does not matter)
+    for x in &mut d {
+        *x = (*x - med).abs();
+    }
+    1.4826 * median_in_place(&mut d) / 2f64.sqrt()
 }
 
 /// Threshold crossings of `kp` at times `t`, as event times \[s\], with the threshold,

@@ -612,6 +612,21 @@ pub fn time_of(
     acq: &Acquisition,
     which: Which,
 ) -> Result<Vec<f64>, AcquisitionError> {
+    let n = check_time(raw, acq, which)?;
+    Ok(match &acq.time {
+        TimeBase::RateHz(r) => (0..n).map(|i| i as f64 / r).collect(),
+        TimeBase::Column(c) => raw.column(c).map(<[f64]>::to_vec).unwrap_or_default(),
+    })
+}
+
+/// The checks of [`time_of`] without the copy of the stamps: every required column
+/// present, the rate valid or the time column as long as the first probe's, finite and
+/// increasing. Returns the number of samples (the first probe's length).
+pub(crate) fn check_time(
+    raw: &RawRecord,
+    acq: &Acquisition,
+    which: Which,
+) -> Result<usize, AcquisitionError> {
     // Every required column must be present, whatever is checked first.
     for (name, role) in acq.columns() {
         if raw.column(name).is_none() {
@@ -631,23 +646,24 @@ pub fn time_of(
             check("acquisition.rate_hz", *r, "finite and > 0 (Hz)", |v| {
                 v > 0.0
             })?;
-            Ok((0..n).map(|i| i as f64 / r).collect())
         }
         TimeBase::Column(c) => {
             let t = column(raw, c, "time", which, Some(n), None)?;
-            for i in 1..t.len() {
-                if t[i].partial_cmp(&t[i - 1]) != Some(std::cmp::Ordering::Greater) {
-                    return Err(AcquisitionError::TimeNotIncreasing {
-                        which,
-                        index: i,
-                        t: t[i],
-                        previous: t[i - 1],
-                    });
-                }
+            // the first step that does not increase (one pass, no early exit to test)
+            if let Some(i) = t
+                .windows(2)
+                .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+            {
+                return Err(AcquisitionError::TimeNotIncreasing {
+                    which,
+                    index: i + 1,
+                    t: t[i + 1],
+                    previous: t[i],
+                });
             }
-            Ok(t.to_vec())
         }
     }
+    Ok(n)
 }
 
 /// The times the keyphasor is timed on: the uniform grid fitted over the stamps `t` when

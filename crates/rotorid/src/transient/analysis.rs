@@ -19,8 +19,9 @@ use super::critical::{criticals, separation_margin, Critical, CriticalSettings, 
 use super::error::TransientError;
 use super::modes::{self, fit_modes, FitBasis, ModeFit, ModeSettings, SensorSeries};
 use super::order::{bin, track, OrderSettings, Tracked, C64};
-use super::record::track_record;
+use super::record::{track_record, track_record_owned, RecordTrack};
 use super::slow_roll::{self, SlowRoll, SlowRollSource};
+use super::spectrum::{record_cascades, Cascade, CascadeSettings};
 use super::synchronous::Sweep;
 use crate::acquisition::{Acquisition, KeyphasorReport, Probe, RawRecord, Which};
 use crate::model::{rad_per_s_to_rpm, rpm_to_rad_per_s, OutOfRange};
@@ -47,6 +48,9 @@ pub struct Settings {
     pub critical: CriticalSettings,
     /// The mode fit's settings; `None`: no mode fit.
     pub modes: Option<ModeSettings>,
+    /// The cascades of each raw record ([`Spectra`]), computed as it is added; `None`:
+    /// none.
+    pub cascade: Option<CascadeSettings>,
 }
 
 impl Default for Settings {
@@ -58,6 +62,7 @@ impl Default for Settings {
             operating_rpm: None,
             critical: CriticalSettings::default(),
             modes: Some(ModeSettings::default()),
+            cascade: Some(CascadeSettings::default()),
         }
     }
 }
@@ -233,15 +238,42 @@ impl Sensor {
     }
 }
 
-/// The samples of one raw record, for the spectra.
+/// The spectra of one raw record, computed when it is added (so that its samples are not
+/// kept until the figures): each probe's cascade and, for an XY pair, the full-spectrum
+/// cascade, or why one could not be computed (the figures report it).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Samples {
-    /// Time \[s\].
-    pub t: Vec<f64>,
-    /// Shaft speed \[rad/s\].
-    pub omega: Vec<f64>,
-    /// Each probe's displacement towards it \[m\].
-    pub displacement: Vec<Vec<f64>>,
+pub struct Spectra {
+    /// Each probe's cascade ([`super::spectrum::cascade`]) of its displacement \[m\], in
+    /// the order of the sensors.
+    pub probes: Vec<Result<Cascade, TransientError>>,
+    /// The full-spectrum cascade of the pair ([`super::spectrum::full_cascade`]) of x and z
+    /// from the two displacements; `None` with one probe.
+    pub full: Option<Result<Cascade, TransientError>>,
+}
+
+impl Spectra {
+    /// The spectra of the record's samples: times `t` \[s\], shaft speed `omega`
+    /// \[rad/s\], each probe's `displacement` \[m\]; the pair's angles `pair` \[rad\] for
+    /// the full spectrum.
+    pub fn of(
+        t: &[f64],
+        omega: &[f64],
+        displacement: &[Vec<f64>],
+        pair: Option<[f64; 2]>,
+        settings: &CascadeSettings,
+    ) -> Self {
+        let signals: Vec<&[f64]> = displacement.iter().map(Vec::as_slice).collect();
+        let pair = match (pair, displacement) {
+            (Some(angles), [_, _]) => Some(
+                crate::acquisition::probes::inverse_projection(angles)
+                    .map_err(TransientError::from),
+            ),
+            _ => None,
+        };
+        // the blocks planned once for the record's cascades
+        let (probes, full) = record_cascades(t, omega, &signals, pair, settings);
+        Self { probes, full }
+    }
 }
 
 /// Everything a transient analysis computes.
@@ -255,8 +287,8 @@ pub struct Analysis {
     pub sensors: Vec<Sensor>,
     /// The keyphasor reports per record (raw records).
     pub keyphasor: Vec<KeyphasorReport>,
-    /// Per sample data for the spectra, per record (raw records).
-    pub samples: Vec<Samples>,
+    /// The spectra of each raw record (none from a table, or when not asked for).
+    pub spectra: Vec<Spectra>,
     /// Notes for the reader.
     pub notes: Vec<String>,
     /// The operating range \[rev/min\].
@@ -358,7 +390,7 @@ pub struct RawAnalysis<'a> {
     sources: Vec<String>,
     tracked: Vec<Tracked>,
     keyphasor: Vec<KeyphasorReport>,
-    samples: Vec<Samples>,
+    spectra: Vec<Spectra>,
 }
 
 impl<'a> RawAnalysis<'a> {
@@ -378,7 +410,7 @@ impl<'a> RawAnalysis<'a> {
             sources: Vec::new(),
             tracked: Vec::new(),
             keyphasor: Vec::new(),
-            samples: Vec::new(),
+            spectra: Vec::new(),
         })
     }
 
@@ -403,7 +435,7 @@ impl<'a> RawAnalysis<'a> {
             sources: Vec::new(),
             tracked: Vec::new(),
             keyphasor: Vec::new(),
-            samples: Vec::new(),
+            spectra: Vec::new(),
         })
     }
 
@@ -429,7 +461,16 @@ impl<'a> RawAnalysis<'a> {
         }
     }
 
-    fn push(&mut self, source: &str, tracked: Vec<Tracked>, samples: Samples) {
+    /// The record's tracked vectors added, and its spectra computed from its samples
+    /// (which the caller can then drop).
+    fn push(
+        &mut self,
+        source: &str,
+        tracked: Vec<Tracked>,
+        t: &[f64],
+        omega: &[f64],
+        displacement: &[Vec<f64>],
+    ) {
         for (k, t) in tracked.into_iter().enumerate() {
             match self.tracked.get_mut(k) {
                 Some(all) => all.revolutions.extend(t.revolutions),
@@ -437,7 +478,19 @@ impl<'a> RawAnalysis<'a> {
             }
         }
         self.sources.push(source.to_owned());
-        self.samples.push(samples);
+        if let Some(settings) = &self.settings.cascade {
+            let pair =
+                (self.probes.len() == 2).then(|| [self.probes[0].angle, self.probes[1].angle]);
+            self.spectra
+                .push(Spectra::of(t, omega, displacement, pair, settings));
+        }
+    }
+
+    /// The record's track added ([`RawAnalysis::push`]).
+    fn push_track(&mut self, source: &str, r: RecordTrack) {
+        self.keyphasor.push(r.keyphasor);
+        let tracked = r.probes.into_iter().map(|p| p.tracked).collect();
+        self.push(source, tracked, &r.t, &r.omega, &r.displacement);
     }
 
     /// Order-track the next raw record of the event, `source` naming it (errors start
@@ -455,17 +508,27 @@ impl<'a> RawAnalysis<'a> {
             Which::Running,
         )
         .map_err(within(format!("{source}: order tracking")))?;
-        self.keyphasor.push(r.keyphasor);
-        let tracked = r.probes.into_iter().map(|p| p.tracked).collect();
-        self.push(
-            source,
-            tracked,
-            Samples {
-                t: r.t,
-                omega: r.omega,
-                displacement: r.displacement,
-            },
-        );
+        self.push_track(source, r);
+        Ok(())
+    }
+
+    /// [`RawAnalysis::add_record`] of a record the caller gives away: the same results,
+    /// its columns moved out of it rather than copied (`record::track_record_owned`), so
+    /// that the record is not held beside the tracking's own columns.
+    pub fn add_record_owned(&mut self, source: &str, raw: RawRecord) -> Result<(), TransientError> {
+        let acq = self.acq.ok_or_else(|| TransientError::Unusable {
+            input: source.to_owned(),
+            reason: "a raw record (probe volts and a keyphasor) needs the scenario's [acquisition]; this analysis takes records with a shaft angle",
+        })?;
+        let r = track_record_owned(
+            raw,
+            acq,
+            self.indices(),
+            &self.settings.order,
+            Which::Running,
+        )
+        .map_err(within(format!("{source}: order tracking")))?;
+        self.push_track(source, r);
         Ok(())
     }
 
@@ -501,15 +564,7 @@ impl<'a> RawAnalysis<'a> {
             .collect::<Result<Vec<_>, _>>()
             .map_err(within(format!("{source}: order tracking")))?;
         let omega = angular_speed(&t, phi);
-        self.push(
-            source,
-            tracked,
-            Samples {
-                t,
-                omega,
-                displacement,
-            },
-        );
+        self.push(source, tracked, &t, &omega, &displacement);
         Ok(())
     }
 
@@ -665,7 +720,7 @@ impl<'a> RawAnalysis<'a> {
             direction: Direction::of(&rpm),
             sensors,
             keyphasor: self.keyphasor,
-            samples: self.samples,
+            spectra: self.spectra,
             notes,
             operating_rpm: self.settings.operating_rpm,
             bin_rpm: self.settings.bin_rpm,
@@ -760,7 +815,7 @@ pub fn analyse_table(
         direction: Direction::of(&rpm),
         sensors,
         keyphasor: Vec::new(),
-        samples: Vec::new(),
+        spectra: Vec::new(),
         notes,
         operating_rpm: settings.operating_rpm,
         bin_rpm: None,

@@ -325,17 +325,26 @@ fn smoothed_events(t: &[f64], ev: &[(f64, f64)]) -> Vec<Node> {
 }
 
 /// `psi` with its events smoothed (module doc): the same length. Unchanged with fewer
-/// than 5 events; before the first and after the last event the measured angle is kept.
+/// than 5 events.
 pub fn smooth(t: &[f64], psi: &[f64]) -> Vec<f64> {
+    let mut out = psi.to_vec();
+    smooth_in_place(t, &mut out);
+    out
+}
+
+/// [`smooth`] in place: `psi` becomes the smoothed angle (no second copy of the record's
+/// angle). The same values: each sample's new angle depends on the events, found before
+/// anything is changed, and on its own time.
+pub fn smooth_in_place(t: &[f64], psi: &mut [f64]) {
     let ev = events(t, psi);
     if ev.len() < 5 || t.len() != psi.len() {
-        return psi.to_vec();
+        return;
     }
     let nodes = smoothed_events(t, &ev);
-    let mut out = psi.to_vec();
     if nodes.len() < 2 {
-        return out;
+        return;
     }
+    let out = psi;
     let (first, last) = (nodes[0], nodes[nodes.len() - 1]);
     let mut j = 0;
     for (i, o) in out.iter_mut().enumerate() {
@@ -365,7 +374,6 @@ pub fn smooth(t: &[f64], psi: &[f64]) -> Vec<f64> {
             out[i] = out[i - 1];
         }
     }
-    out
 }
 
 #[cfg(test)]

@@ -34,7 +34,7 @@ pub use critical::{criticals, separation_margin, Critical, CriticalSettings, Mar
 pub use error::TransientError;
 pub use modes::{fit_modes, FitBasis, FittedMode, ModeFit, ModeGuess, ModeSettings};
 pub use order::{track, OrderSettings, Revolution, Tracked};
-pub use record::{track_record, ProbeTrack, RecordTrack};
+pub use record::{track_record, track_record_owned, ProbeTrack, RecordTrack};
 pub use report::{transient_json, TransientJson};
 pub use slow_roll::{compensate, SlowRoll, SlowRollSource};
-pub use spectrum::{cascade, full_cascade, Cascade, CascadeSettings, Peak};
+pub use spectrum::{cascade, full_cascade, full_cascade_of_pair, Cascade, CascadeSettings, Peak};

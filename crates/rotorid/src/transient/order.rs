@@ -193,12 +193,31 @@ pub fn track(
     signal: &[f64],
     settings: &OrderSettings,
 ) -> Result<Tracked, TransientError> {
+    let mut one = track_signals(t, psi, &[signal], settings)?;
+    Ok(one.pop().expect("one signal tracked"))
+}
+
+/// Track each of `signals` (the probes of one record: each the same length as `t` and
+/// `psi`) per revolution, as [`track`] does one, with the same results bit for bit. The
+/// regressors of a revolution, its normal equations and their factorisation depend on
+/// the angle alone, so they are computed once for all the signals, and the regressors once
+/// per sample instead of twice per signal.
+pub fn track_signals(
+    t: &[f64],
+    psi: &[f64],
+    signals: &[&[f64]],
+    settings: &OrderSettings,
+) -> Result<Vec<Tracked>, TransientError> {
     settings.validate()?;
     same_length("psi", psi.len(), "t", t.len())?;
-    same_length("signal", signal.len(), "t", t.len())?;
+    for s in signals {
+        same_length("signal", s.len(), "t", t.len())?;
+    }
     check_finite("t", t)?;
     check_finite("psi", psi)?;
-    check_finite("signal", signal)?;
+    for s in signals {
+        check_finite("signal", s)?;
+    }
     let top = settings.max_order() as usize;
     let wanted = settings.harmonics.max(top);
     let revs = revolutions(t, psi);
@@ -209,8 +228,12 @@ pub fn track(
             needed: 2,
         });
     }
-    let mut fits = Vec::with_capacity(revs.len());
-    let mut fit = RevolutionFit::default();
+    let mut shared = Vec::with_capacity(revs.len());
+    let mut fits: Vec<Vec<SignalFit>> = signals
+        .iter()
+        .map(|_| Vec::with_capacity(revs.len()))
+        .collect();
+    let mut normal = Normal::default();
     for (k, (range, t0, _)) in revs.iter().enumerate() {
         let n = range.len();
         // unknowns p = 1 + 2 H, at least as many residual degrees of freedom as unknowns
@@ -224,29 +247,47 @@ pub fn track(
                 needed: 2 * (1 + 2 * top),
             });
         }
-        fits.push(fit.fit(&psi[range.clone()], &signal[range.clone()], h, k, *t0)?);
+        shared.push(normal.build(&psi[range.clone()], h, &settings.orders, k, *t0)?);
+        for (s, out) in signals.iter().zip(&mut fits) {
+            out.push(normal.fit(&s[range.clone()]));
+        }
     }
-    // the gap's drift per revolution from the neighbours' constants, and its effect on
-    // each revolution's coefficients removed (module doc)
+    Ok(fits
+        .into_iter()
+        .map(|f| finish(&revs, &shared, f, settings))
+        .collect())
+}
+
+/// One signal's revolutions from their fits: the gap's drift per revolution from the
+/// neighbours' constants, and its effect on each revolution's coefficients removed (module
+/// doc); the vectors, their standard deviations, the speeds smoothed.
+fn finish(
+    revs: &[(std::ops::Range<usize>, f64, f64)],
+    shared: &[RevolutionFit],
+    fits: Vec<SignalFit>,
+    settings: &OrderSettings,
+) -> Tracked {
     let c: Vec<f64> = fits.iter().map(|f| f.theta[0]).collect();
     let m = c.len();
     let mut out = Vec::with_capacity(m);
-    for (k, ((_, t0, t1), f)) in revs.into_iter().zip(fits).enumerate() {
+    for (k, (((_, t0, t1), r), f)) in revs.iter().zip(shared).zip(fits).enumerate() {
+        let (t0, t1) = (*t0, *t1);
         let d = match k {
             0 => c[1] - c[0],
             _ if k == m - 1 => c[m - 1] - c[m - 2],
             _ => 0.5 * (c[k + 1] - c[k - 1]),
         };
-        let theta: Vec<f64> = f.theta.iter().zip(&f.g).map(|(th, g)| th - d * g).collect();
-        let rss = (f.rss - 2.0 * d * f.eu + d * d * f.uu).max(0.0);
-        let sigma2 = rss / (f.n - f.p) as f64;
+        let theta: Vec<f64> = f.theta.iter().zip(&r.g).map(|(th, g)| th - d * g).collect();
+        let rss = (f.rss - 2.0 * d * f.eu + d * d * r.uu).max(0.0);
+        let sigma2 = rss / (r.n - r.p) as f64;
         let (vectors, std) = settings
             .orders
             .iter()
-            .map(|&o| {
+            .zip(&r.inv_diag)
+            .map(|(&o, &(ia, ib))| {
                 let j = o as usize;
                 let (a, b) = (theta[2 * j - 1], theta[2 * j]);
-                let var = 0.5 * sigma2 * (f.inv_diag[2 * j - 1] + f.inv_diag[2 * j]);
+                let var = 0.5 * sigma2 * (ia + ib);
                 (C64::new(a, -b), var.max(0.0).sqrt())
             })
             .unzip();
@@ -255,17 +296,17 @@ pub fn track(
             t_end: t1,
             speed: TAU / (t1 - t0),
             dc: theta[0],
-            noise: (rss / f.n as f64).sqrt(),
+            noise: (rss / r.n as f64).sqrt(),
             vectors,
             std,
             count: 1,
         });
     }
     smooth_speeds(&mut out);
-    Ok(Tracked {
+    Tracked {
         orders: settings.orders.clone(),
         revolutions: out,
-    })
+    }
 }
 
 /// Revolutions on each side of one whose speeds smooth its own.
@@ -306,78 +347,224 @@ fn smooth_speeds(revs: &mut [Revolution]) {
     }
 }
 
-/// The least squares of one revolution.
+/// The least squares of one revolution, the part common to every signal: the regressors
+/// of each sample, the normal matrix A^T A factorised, and what a drift d u
+/// (u = (psi - psi_m) / 2 pi) changes (module doc). Its buffers are reused from one
+/// revolution to the next.
+///
+/// The regressors are kept column by column (each harmonic's cos and sin over the
+/// samples), so that every sum over the samples is a dot product of two contiguous
+/// columns. A^T A is not summed entry by entry (p (p + 1) / 2 = 153 products a sample for
+/// H = 8): its entries are sums of products of harmonics, which are harmonics again,
+/// `cos a cos b = (cos (a - b) + cos (a + b)) / 2` and the like, so it is assembled from
+/// the 2 (2 H) + 1 sums of cos(m psi) and sin(m psi), m = 0 .. 2 H ([`normal_from_sums`]).
+/// The same matrix to rounding (each entry is now a sum of two rounded sums instead of one
+/// sum of rounded products): the coefficients move by a few units of their last digits.
 #[derive(Default)]
-struct RevolutionFit {
-    row: Vec<f64>,
+struct Normal {
+    /// The columns cos(psi), sin(psi), ..., cos(H psi), sin(H psi), each of the
+    /// revolution's samples, one after the other (2 H n values).
+    cols: Vec<f64>,
+    /// u = (psi - psi_m) / 2 pi of each sample.
+    u: Vec<f64>,
+    /// Scratch: cos(m psi), sin(m psi) for m > H (their sums only are needed).
+    high: [Vec<f64>; 2],
+    /// Scratch: one signal about its first sample, then its residuals.
+    y: Vec<f64>,
+    /// Samples of the current revolution.
+    n: usize,
+    /// Unknowns of the current revolution.
+    p: usize,
+    /// The factorisation of the current revolution's A^T A.
+    chol: Option<nalgebra::linalg::Cholesky<f64, nalgebra::Dyn>>,
 }
 
-/// One revolution's fit without drift: coefficients (c, a_1, b_1, ..., a_H, b_H), the
-/// diagonal of (A^T A)^-1, the residual sum of squares, and what removing a drift
-/// d u (u = (psi - psi_m) / 2 pi) changes: g = (A^T A)^-1 A^T u (the coefficients move
-/// by -d g), e.u with e the residual, and |u - A g|^2.
-struct FitResult {
-    theta: Vec<f64>,
-    inv_diag: Vec<f64>,
-    rss: f64,
+/// A revolution's fit without drift, the part common to every signal: g = (A^T A)^-1
+/// A^T u (a drift d moves the coefficients by -d g), |u - A g|^2, the diagonal of
+/// (A^T A)^-1 at (a_n, b_n) of each order, N and p.
+struct RevolutionFit {
     g: Vec<f64>,
-    eu: f64,
     uu: f64,
+    inv_diag: Vec<(f64, f64)>,
     n: usize,
     p: usize,
 }
 
-impl RevolutionFit {
-    /// The regressors of angle `p` (module doc) into `self.row`.
-    fn regressors(&mut self, p: f64, h: usize) {
-        self.row.clear();
-        self.row.push(1.0);
-        let (s1, c1) = p.sin_cos();
-        let base = C64::new(c1, s1);
-        let mut e = base;
-        for _ in 0..h {
-            self.row.push(e.re);
-            self.row.push(e.im);
-            e *= base;
+/// A revolution's fit of one signal without drift: the coefficients
+/// (c, a_1, b_1, ..., a_H, b_H), the residual sum of squares, and e.u with e the residual.
+struct SignalFit {
+    theta: Vec<f64>,
+    rss: f64,
+    eu: f64,
+}
+
+/// Sum of `a` (four running sums, so that the additions of neighbouring samples do not
+/// wait for each other and can go two or four at a time).
+#[inline]
+fn sum(a: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let mut chunks = a.chunks_exact(4);
+    for c in &mut chunks {
+        for l in 0..4 {
+            acc[l] += c[l];
         }
     }
+    let tail: f64 = chunks.remainder().iter().sum();
+    (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
+}
 
-    fn fit(
+/// The dot product of `a` and `b` (same length), four running sums as [`sum`].
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let mut ca = a.chunks_exact(4);
+    let mut cb = b.chunks_exact(4);
+    for (x, y) in (&mut ca).zip(&mut cb) {
+        for l in 0..4 {
+            acc[l] += x[l] * y[l];
+        }
+    }
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
+}
+
+/// cos(m psi), sin(m psi) of each sample from those of (m - 1) psi and psi: one complex
+/// multiplication a sample, as the rows were built before.
+#[inline]
+fn next_harmonic(prev: (&[f64], &[f64]), first: (&[f64], &[f64]), out: (&mut [f64], &mut [f64])) {
+    let (pc, ps) = prev;
+    let (c1, s1) = first;
+    let (oc, os) = out;
+    for k in 0..oc.len() {
+        let (a, b, c, d) = (pc[k], ps[k], c1[k], s1[k]);
+        oc[k] = a * c - b * d;
+        os[k] = a * d + b * c;
+    }
+}
+
+/// A^T A (p x p, p = 1 + 2 h; regressors 1, cos psi, sin psi, ..., cos h psi, sin h psi)
+/// from the sums `c[m]` of cos(m psi) and `s[m]` of sin(m psi) over the samples,
+/// m = 0 .. 2 h (c\[0\] the count, s\[0\] = 0): with C_-m = C_m and S_-m = -S_m,
+///
+/// ```text
+/// sum cos(a psi) cos(b psi) = (C_(a-b) + C_(a+b)) / 2
+/// sum sin(a psi) sin(b psi) = (C_(a-b) - C_(a+b)) / 2
+/// sum cos(a psi) sin(b psi) = (S_(a+b) - S_(a-b)) / 2
+/// ```
+fn normal_from_sums(c: &[f64], s: &[f64], h: usize) -> DMatrix<f64> {
+    let p = 1 + 2 * h;
+    let cm = |m: isize| c[m.unsigned_abs()];
+    let sm = |m: isize| {
+        if m < 0 {
+            -s[m.unsigned_abs()]
+        } else {
+            s[m as usize]
+        }
+    };
+    DMatrix::<f64>::from_fn(p, p, |i, j| {
+        // regressor i: 0 the constant, 2 a - 1 cos(a psi), 2 a sin(a psi)
+        let kind = |i: usize| -> (isize, bool) { (i.div_ceil(2) as isize, i % 2 == 0) };
+        if i == 0 && j == 0 {
+            return c[0];
+        }
+        if i == 0 || j == 0 {
+            let (m, sine) = kind(i.max(j));
+            return if sine { sm(m) } else { cm(m) };
+        }
+        let ((a, sa), (b, sb)) = (kind(i), kind(j));
+        match (sa, sb) {
+            (false, false) => 0.5 * (cm(a - b) + cm(a + b)),
+            (true, true) => 0.5 * (cm(a - b) - cm(a + b)),
+            // cos(a psi) sin(b psi)
+            (false, true) => 0.5 * (sm(a + b) - sm(a - b)),
+            (true, false) => 0.5 * (sm(a + b) - sm(b - a)),
+        }
+    })
+}
+
+impl Normal {
+    /// The column of cos(m psi) (`sine` false) or sin(m psi), m = 1 .. H.
+    fn col(&self, m: usize, sine: bool) -> &[f64] {
+        let at = (2 * (m - 1) + usize::from(sine)) * self.n;
+        &self.cols[at..at + self.n]
+    }
+
+    /// The regressors, normal equations and factorisation of the revolution with angles
+    /// `psi` and `h` harmonics; `orders` the orders whose variances are wanted; `k`, `t0`
+    /// name the revolution in an error.
+    fn build(
         &mut self,
         psi: &[f64],
-        s: &[f64],
         h: usize,
+        orders: &[u32],
         k: usize,
         t0: f64,
-    ) -> Result<FitResult, TransientError> {
+    ) -> Result<RevolutionFit, TransientError> {
         let p = 1 + 2 * h;
-        let n = s.len();
+        let n = psi.len();
+        self.p = p;
+        self.n = n;
         let mid = 0.5 * (psi[0] + psi[n - 1]);
-        // the signal about its first sample, so the sums of squares keep their digits
-        let s0 = s[0];
-        let mut ata = DMatrix::<f64>::zeros(p, p);
-        let mut atb = DVector::<f64>::zeros(p);
-        let mut atu = DVector::<f64>::zeros(p);
-        let mut uu = 0.0;
-        for (&pk, &sk) in psi.iter().zip(s) {
-            self.regressors(pk, h);
-            let y = sk - s0;
-            let u = (pk - mid) / TAU;
-            uu += u * u;
-            for i in 0..p {
-                let ri = self.row[i];
-                atb[i] += ri * y;
-                atu[i] += ri * u;
-                for j in i..p {
-                    ata[(i, j)] += ri * self.row[j];
+        self.u.clear();
+        self.u.extend(psi.iter().map(|&pk| (pk - mid) / TAU));
+        self.cols.clear();
+        self.cols.resize(2 * h * n, 0.0);
+        {
+            let (c1, rest) = self.cols.split_at_mut(n);
+            for ((c, s), &pk) in c1.iter_mut().zip(&mut rest[..n]).zip(psi) {
+                (*s, *c) = pk.sin_cos();
+            }
+        }
+        // the sums of cos(m psi), sin(m psi), m = 0 .. 2 h
+        let mut cs = vec![0.0; 2 * h + 1];
+        let mut ss = vec![0.0; 2 * h + 1];
+        cs[0] = n as f64;
+        for m in 1..=h {
+            if m > 1 {
+                let (done, out) = self.cols.split_at_mut(2 * (m - 1) * n);
+                let (oc, os) = out[..2 * n].split_at_mut(n);
+                let first = (&done[..n], &done[n..2 * n]);
+                let prev = &done[2 * (m - 2) * n..];
+                next_harmonic((&prev[..n], &prev[n..2 * n]), first, (oc, os));
+            }
+            cs[m] = sum(self.col(m, false));
+            ss[m] = sum(self.col(m, true));
+        }
+        for m in h + 1..=2 * h {
+            let [hc, hs] = &mut self.high;
+            hc.resize(n, 0.0);
+            hs.resize(n, 0.0);
+            let first = (&self.cols[..n], &self.cols[n..2 * n]);
+            if m == h + 1 {
+                let at = 2 * (h - 1) * n;
+                let prev = (&self.cols[at..at + n], &self.cols[at + n..at + 2 * n]);
+                next_harmonic(prev, first, (&mut hc[..], &mut hs[..]));
+            } else {
+                // in place: each sample's new value depends on its own old one only
+                for k in 0..n {
+                    let (a, b, c, d) = (hc[k], hs[k], first.0[k], first.1[k]);
+                    hc[k] = a * c - b * d;
+                    hs[k] = a * d + b * c;
                 }
             }
+            cs[m] = sum(&hc[..]);
+            ss[m] = sum(&hs[..]);
         }
-        for i in 0..p {
-            for j in 0..i {
-                ata[(i, j)] = ata[(j, i)];
-            }
+        let ata = normal_from_sums(&cs, &ss, h);
+        let mut atu = DVector::<f64>::zeros(p);
+        atu[0] = sum(&self.u);
+        for m in 1..=h {
+            atu[2 * m - 1] = dot(self.col(m, false), &self.u);
+            atu[2 * m] = dot(self.col(m, true), &self.u);
         }
+        let uu = dot(&self.u, &self.u);
         let chol = ata
             .cholesky()
             .ok_or(TransientError::TooFewSamplesPerRevolution {
@@ -387,29 +574,72 @@ impl RevolutionFit {
                 order: h as u32,
                 needed: 2 * p,
             })?;
-        let mut theta = chol.solve(&atb);
         let g = chol.solve(&atu);
-        let mut rss = 0.0;
-        let mut eu = 0.0;
-        for (&pk, &sk) in psi.iter().zip(s) {
-            self.regressors(pk, h);
-            let f: f64 = self.row.iter().zip(theta.iter()).map(|(r, c)| r * c).sum();
-            let e = sk - s0 - f;
-            rss += e * e;
-            eu += e * (pk - mid) / TAU;
-        }
-        theta[0] += s0;
-        let inv = chol.inverse();
-        Ok(FitResult {
-            theta: theta.iter().copied().collect(),
-            inv_diag: (0..p).map(|i| inv[(i, i)]).collect(),
-            rss,
+        // the diagonal of (A^T A)^-1 where it is needed: column by column, as the whole
+        // inverse is computed
+        let inv = |i: usize| {
+            let mut e = DVector::<f64>::zeros(p);
+            e[i] = 1.0;
+            chol.solve_mut(&mut e);
+            e[i]
+        };
+        let inv_diag = orders
+            .iter()
+            .map(|&o| {
+                let j = o as usize;
+                (inv(2 * j - 1), inv(2 * j))
+            })
+            .collect();
+        let uu = uu - g.dot(&atu);
+        self.chol = Some(chol);
+        Ok(RevolutionFit {
             g: g.iter().copied().collect(),
-            eu,
-            uu: uu - g.dot(&atu),
+            uu,
+            inv_diag,
             n,
             p,
         })
+    }
+
+    /// The fit of the signal `s` over the revolution last built.
+    fn fit(&mut self, s: &[f64]) -> SignalFit {
+        let (p, n) = (self.p, self.n);
+        let h = (p - 1) / 2;
+        // the signal about its first sample, so the sums of squares keep their digits
+        let s0 = s[0];
+        let mut y = std::mem::take(&mut self.y);
+        y.clear();
+        y.extend(s[..n].iter().map(|&sk| sk - s0));
+        let mut theta = DVector::<f64>::zeros(p);
+        theta[0] = sum(&y);
+        for m in 1..=h {
+            theta[2 * m - 1] = dot(self.col(m, false), &y);
+            theta[2 * m] = dot(self.col(m, true), &y);
+        }
+        self.chol
+            .as_ref()
+            .expect("a revolution built before its fits")
+            .solve_mut(&mut theta);
+        // the residuals in place of y: e = y - c - sum a_m cos(m psi) + b_m sin(m psi)
+        let c = theta[0];
+        for v in y.iter_mut() {
+            *v -= c;
+        }
+        for m in 1..=h {
+            let (a, b) = (theta[2 * m - 1], theta[2 * m]);
+            for ((v, &cm), &sm) in y.iter_mut().zip(self.col(m, false)).zip(self.col(m, true)) {
+                *v -= a * cm + b * sm;
+            }
+        }
+        let rss = dot(&y, &y);
+        let eu = dot(&y, &self.u);
+        self.y = y;
+        theta[0] += s0;
+        SignalFit {
+            theta: theta.iter().copied().collect(),
+            rss,
+            eu,
+        }
     }
 }
 
@@ -427,17 +657,17 @@ pub fn bin(tracked: &Tracked, width_rpm: f64) -> Result<Tracked, TransientError>
         .into());
     }
     let m = tracked.orders.len();
-    let mut keys: Vec<i64> = Vec::new();
+    // each bin's place in `groups` by its key: a narrow bin on a long record makes
+    // thousands of bins, and a search through them per revolution grew as their product
+    let mut index: std::collections::HashMap<i64, usize> = std::collections::HashMap::new();
     let mut groups: Vec<Vec<&Revolution>> = Vec::new();
     for r in &tracked.revolutions {
         let key = (r.rpm() / width_rpm).floor() as i64;
-        match keys.iter().position(|&k| k == key) {
-            Some(i) => groups[i].push(r),
-            None => {
-                keys.push(key);
-                groups.push(vec![r]);
-            }
-        }
+        let i = *index.entry(key).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[i].push(r);
     }
     let revolutions = groups
         .into_iter()
@@ -485,6 +715,73 @@ mod tests {
         let t: Vec<f64> = (0..n).map(|i| i as f64 / fs).collect();
         let psi = t.iter().map(|&t| w0 * t + 0.5 * a * t * t).collect();
         (t, psi)
+    }
+
+    /// A^T A assembled from the sums of cos(m psi) and sin(m psi) is the sum of the
+    /// products of the regressors to rounding, and the fit of a revolution the least
+    /// squares solution of its samples (nalgebra's SVD of the whole design matrix).
+    #[test]
+    fn normal_equations_from_harmonic_sums_equal_the_products() {
+        let (_, psi) = run_up(40.0, 30.0, 2000.0, 3.0);
+        // one revolution from psi = 20 pi, unevenly spaced (a run-up)
+        let a = psi
+            .iter()
+            .position(|&p| p >= 20.0 * std::f64::consts::PI)
+            .unwrap();
+        let b = psi
+            .iter()
+            .position(|&p| p >= 22.0 * std::f64::consts::PI)
+            .unwrap();
+        let psi = &psi[a..b];
+        let h = 8;
+        let p = 1 + 2 * h;
+        let design = DMatrix::<f64>::from_fn(psi.len(), p, |k, j| match j {
+            0 => 1.0,
+            _ if j % 2 == 1 => (j.div_ceil(2) as f64 * psi[k]).cos(),
+            _ => ((j / 2) as f64 * psi[k]).sin(),
+        });
+        let direct = design.transpose() * &design;
+        let mut normal = super::Normal::default();
+        normal.build(psi, h, &[1, 2], 0, 0.0).unwrap();
+        let cs: Vec<f64> = (0..=2 * h)
+            .map(|m| psi.iter().map(|&x| (m as f64 * x).cos()).sum())
+            .collect();
+        let ss: Vec<f64> = (0..=2 * h)
+            .map(|m| psi.iter().map(|&x| (m as f64 * x).sin()).sum())
+            .collect();
+        let from_sums = normal_from_sums(&cs, &ss, h);
+        let scale = psi.len() as f64;
+        assert!(
+            (&from_sums - &direct).amax() < 1e-12 * scale,
+            "{}",
+            (&from_sums - &direct).amax()
+        );
+        // a signal of the model plus noise: the coefficients of the least squares
+        let mut rng = rand::rngs::StdRng::seed_from_u64(1);
+        let noise = Normal::new(0.0, 0.1).unwrap();
+        let y: Vec<f64> = psi
+            .iter()
+            .map(|&x| 3.0 + 2.0 * x.cos() - 0.5 * (2.0 * x).sin() + noise.sample(&mut rng))
+            .collect();
+        let fit = normal.fit(&y);
+        let ls = design
+            .clone()
+            .svd(true, true)
+            .solve(&DVector::from_column_slice(&y), 1e-14)
+            .unwrap();
+        for (j, (x, want)) in fit.theta.iter().zip(ls.iter()).enumerate() {
+            assert!(
+                (x - want).abs() < 1e-12,
+                "coefficient {j}: {x} against {want}"
+            );
+        }
+        let resid = DVector::from_column_slice(&y) - &design * &ls;
+        let rss = resid.dot(&resid);
+        assert!(
+            (fit.rss / rss - 1.0).abs() < 1e-10,
+            "{} against {rss}",
+            fit.rss
+        );
     }
 
     #[test]

@@ -9,7 +9,7 @@ use rotorid::acquisition::probes::inverse_projection;
 use rotorid::transient::analysis::Analysis;
 use rotorid::transient::order::C64;
 use rotorid::transient::report::lag_deg;
-use rotorid::transient::{cascade, full_cascade, Cascade, CascadeSettings};
+use rotorid::transient::Cascade;
 
 use crate::plot::bode::{unwrap_deg, BodeChannel, BodePlot};
 use crate::plot::campbell::CriticalMark;
@@ -257,18 +257,18 @@ fn joined(parts: Vec<Cascade>) -> Option<Cascade> {
 }
 
 /// The cascade of each probe and, with an XY pair, the full-spectrum cascade (raw
-/// records only; the signals as measured, runout included).
+/// records only; the signals as measured, runout included): the analysis computed them
+/// as each record was added (`Analysis::spectra`).
 fn cascades(a: &Analysis, source: &str) -> anyhow::Result<Vec<(String, String, CascadePlot)>> {
-    if a.samples.is_empty() {
+    if a.spectra.is_empty() {
         return Ok(Vec::new());
     }
-    let settings = CascadeSettings::default();
     let mut out = Vec::new();
     for (k, s) in a.sensors.iter().enumerate() {
         let parts = a
-            .samples
+            .spectra
             .iter()
-            .map(|r| cascade(&r.t, &r.omega, &r.displacement[k], &settings))
+            .map(|r| r.probes[k].clone())
             .collect::<Result<Vec<_>, _>>()?;
         if let Some(c) = joined(parts) {
             let mut plot =
@@ -281,22 +281,11 @@ fn cascades(a: &Analysis, source: &str) -> anyhow::Result<Vec<(String, String, C
             ));
         }
     }
-    if let (Some(angles), 2) = (a.pair_angles, a.sensors.len()) {
-        let inv = inverse_projection(angles)?;
+    if let (Some(_), 2) = (a.pair_angles, a.sensors.len()) {
         let parts = a
-            .samples
+            .spectra
             .iter()
-            .map(|r| {
-                let (x, z): (Vec<f64>, Vec<f64>) = r.displacement[0]
-                    .iter()
-                    .zip(&r.displacement[1])
-                    .map(|(&d1, &d2)| {
-                        let q = inv * nalgebra::Vector2::new(d1, d2);
-                        (q[0], q[1])
-                    })
-                    .unzip();
-                full_cascade(&r.t, &r.omega, &x, &z, &settings)
-            })
+            .filter_map(|r| r.full.clone())
             .collect::<Result<Vec<_>, _>>()?;
         if let Some(c) = joined(parts) {
             out.push((

@@ -218,7 +218,8 @@ fn analyse_raw(args: &TransientArgs, settings: Settings) -> anyhow::Result<Analy
     let mut analysis = RawAnalysis::new(acq, settings).context("--orders")?;
     for input in &args.inputs {
         let raw = raw_record_file(input, acq)?;
-        analysis.add_record(input, &raw)?;
+        // given away: its columns are moved into the tracking, not copied
+        analysis.add_record_owned(input, raw)?;
     }
     let choice = slow_roll_choice(args, &spec, acq)?;
     Ok(analysis.finish(choice)?)
