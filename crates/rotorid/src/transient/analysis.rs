@@ -496,18 +496,32 @@ impl<'a> RawAnalysis<'a> {
     /// Order-track the next raw record of the event, `source` naming it (errors start
     /// with it: `runup.csv: order tracking: ...`).
     pub fn add_record(&mut self, source: &str, raw: &RawRecord) -> Result<(), TransientError> {
-        let acq = self.acq.ok_or_else(|| TransientError::Unusable {
-            input: source.to_owned(),
-            reason: "a raw record (probe volts and a keyphasor) needs the scenario's [acquisition]; this analysis takes records with a shaft angle",
-        })?;
+        let acq = self.raw_acquisition(source)?;
         let r = track_record(
             raw,
             acq,
             self.indices(),
             &self.settings.order,
             Which::Running,
-        )
-        .map_err(within(format!("{source}: order tracking")))?;
+        );
+        self.push_tracked(source, r)
+    }
+
+    /// The scenario's `[acquisition]`, which a raw record needs.
+    fn raw_acquisition(&self, source: &str) -> Result<&'a Acquisition, TransientError> {
+        self.acq.ok_or_else(|| TransientError::Unusable {
+            input: source.to_owned(),
+            reason: "a raw record (probe volts and a keyphasor) needs the scenario's [acquisition]; this analysis takes records with a shaft angle",
+        })
+    }
+
+    /// A raw record's tracking, or its error named by `source`.
+    fn push_tracked(
+        &mut self,
+        source: &str,
+        r: Result<RecordTrack, TransientError>,
+    ) -> Result<(), TransientError> {
+        let r = r.map_err(within(format!("{source}: order tracking")))?;
         self.push_track(source, r);
         Ok(())
     }
@@ -516,20 +530,15 @@ impl<'a> RawAnalysis<'a> {
     /// its columns moved out of it rather than copied (`record::track_record_owned`), so
     /// that the record is not held beside the tracking's own columns.
     pub fn add_record_owned(&mut self, source: &str, raw: RawRecord) -> Result<(), TransientError> {
-        let acq = self.acq.ok_or_else(|| TransientError::Unusable {
-            input: source.to_owned(),
-            reason: "a raw record (probe volts and a keyphasor) needs the scenario's [acquisition]; this analysis takes records with a shaft angle",
-        })?;
+        let acq = self.raw_acquisition(source)?;
         let r = track_record_owned(
             raw,
             acq,
             self.indices(),
             &self.settings.order,
             Which::Running,
-        )
-        .map_err(within(format!("{source}: order tracking")))?;
-        self.push_track(source, r);
-        Ok(())
+        );
+        self.push_tracked(source, r)
     }
 
     /// Order-track the next record of the event whose shaft angle `phi` \[rad\] is known

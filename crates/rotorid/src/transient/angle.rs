@@ -302,8 +302,7 @@ fn smoothed_events(t: &[f64], ev: &[(f64, f64)]) -> Vec<Node> {
     let widest = EVENT_HALF_WINDOWS
         .iter()
         .copied()
-        .filter(|&h| 2 * h < ev.len())
-        .last()
+        .rfind(|&h| 2 * h < ev.len())
         .unwrap_or(EVENT_HALF_WINDOWS[0]);
     let corrected = |reference: &[Node]| {
         sampling_phase_corrected(ev, reference, t[0], dt).map(|c| {

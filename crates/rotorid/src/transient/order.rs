@@ -470,7 +470,7 @@ fn normal_from_sums(c: &[f64], s: &[f64], h: usize) -> DMatrix<f64> {
     };
     DMatrix::<f64>::from_fn(p, p, |i, j| {
         // regressor i: 0 the constant, 2 a - 1 cos(a psi), 2 a sin(a psi)
-        let kind = |i: usize| -> (isize, bool) { (i.div_ceil(2) as isize, i % 2 == 0) };
+        let kind = |i: usize| -> (isize, bool) { (i.div_ceil(2) as isize, i.is_multiple_of(2)) };
         if i == 0 && j == 0 {
             return c[0];
         }

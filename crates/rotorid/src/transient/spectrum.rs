@@ -258,6 +258,12 @@ fn spectra_of(plan: Plan, signal: &[f64]) -> Cascade {
     }
 }
 
+/// Each probe's cascade, and the pair's full spectrum when asked for, each or its error.
+pub type RecordCascades = (
+    Vec<Result<Cascade, TransientError>>,
+    Option<Result<Cascade, TransientError>>,
+);
+
 /// The cascades of one record: [`cascade`] of each of `signals` and, with `pair` (the
 /// inverse of an XY pair's projection, the first two signals its probes),
 /// [`full_cascade_of_pair`], each with the result (or error) those functions give, but
@@ -269,10 +275,7 @@ pub fn record_cascades(
     signals: &[&[f64]],
     pair: Option<Result<nalgebra::Matrix2<f64>, TransientError>>,
     settings: &CascadeSettings,
-) -> (
-    Vec<Result<Cascade, TransientError>>,
-    Option<Result<Cascade, TransientError>>,
-) {
+) -> RecordCascades {
     let mut plan = None;
     let mut plan = || -> Result<Plan, TransientError> {
         plan.get_or_insert_with(|| Plan::new(t, omega, settings))
