@@ -287,6 +287,111 @@ fn run_up_criticals_amplification_factors_and_margins_match_the_steady_state() {
     }
 }
 
+/// `sc` (a scenario file) started in the steady state at `rpm` (phi = 0): x = Re X,
+/// vx = Re(i w X) of the steady 1X vectors X, Z (`steady`'s, before the probes' angles).
+fn start_steady(sc: &str, rpm: f64) {
+    let w = rpm * std::f64::consts::TAU / 60.0;
+    // the probe at 0 deg reads x, at 90 deg z
+    let (x, z) = (steady(rpm, 0.0), steady(rpm, 90.0));
+    let text = std::fs::read_to_string(sc).unwrap().replace(
+        "[speed]",
+        &format!(
+            "[initial]\nx = {}\nz = {}\nvx = {}\nvz = {}\n\n[speed]",
+            x.0,
+            z.0,
+            -w * x.1,
+            -w * z.1
+        ),
+    );
+    std::fs::write(sc, text).unwrap();
+}
+
+#[test]
+fn a_coast_down_from_steady_state_has_its_criticals_below_the_steady_ones_and_the_true_modes() {
+    let dir = tempfile::tempdir().unwrap();
+    // 8900 rpm - 25 rad/s^2 for 34 s: to 783 rpm, through both criticals
+    let sc = scenario(dir.path(), 8900.0, -25.0, 34.0);
+    start_steady(&sc, 8900.0);
+    let raw = dir.path().join("coast.csv");
+    let slow = dir.path().join("slow.csv");
+    let out = rotorid()
+        .args(["simulate", "--scenario", &sc, "--raw", "-q", "--out"])
+        .arg(&raw)
+        .arg("--slow-roll-out")
+        .arg(&slow)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let res = dir.path().join("res");
+    let (ok, stdout, stderr) = run_transient(&[
+        raw.to_str().unwrap(),
+        "--scenario",
+        &sc,
+        "--out",
+        res.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("coast-down"), "{stdout}");
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(res.join("transient.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["direction"], "coast_down");
+    let rows = bode_rows(&res);
+    for (sensor, angle) in [("probe_L", 135.0), ("probe_R", 45.0)] {
+        let truth = steady_criticals(angle);
+        let found: Vec<&Value> = json["criticals"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|c| c["sensor"] == sensor)
+            .collect();
+        assert_eq!(found.len(), 2, "{sensor}: {found:?}");
+        let mut found: Vec<(f64, f64)> = found
+            .iter()
+            .map(|c| {
+                (
+                    c["rpm"].as_f64().unwrap(),
+                    c["amplification_factor"].as_f64().unwrap(),
+                )
+            })
+            .collect();
+        found.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for ((rpm, af), (nc, steady_af)) in found.iter().zip(&truth) {
+            eprintln!(
+                "{sensor}: Nc {rpm:.1} (steady {nc:.1}, {:+.2} %), AF {af:.2} (steady {steady_af:.2})",
+                (rpm / nc - 1.0) * 100.0
+            );
+            // on a coast-down the apparent peak lies below the steady one, within 1.5 %
+            assert!(*rpm < *nc && *rpm > nc * 0.985, "{sensor}: {rpm} vs {nc}");
+            assert!(
+                (af / steady_af - 1.0).abs() < 0.10,
+                "{sensor}: AF {af} vs {steady_af}"
+            );
+        }
+        let mine: Vec<_> = rows.iter().filter(|r| r.1 == sensor && r.2 == 1).collect();
+        let peak = mine
+            .iter()
+            .map(|r| amp(steady(r.0, angle)))
+            .fold(0.0, f64::max);
+        let amp_rms = (mine
+            .iter()
+            .map(|r| (amp((r.3, r.4)) - amp(steady(r.0, angle))).powi(2))
+            .sum::<f64>()
+            / mine.len() as f64)
+            .sqrt();
+        eprintln!(
+            "{sensor}: 1X amplitude RMS error {:.2} % of the peak",
+            amp_rms / peak * 100.0
+        );
+        assert!(amp_rms < 0.03 * peak, "{sensor}: {amp_rms} vs peak {peak}");
+    }
+    check_modes(&json);
+}
+
 #[test]
 fn a_one_x_table_gives_its_critical_and_refuses_duplicates() {
     let dir = tempfile::tempdir().unwrap();
