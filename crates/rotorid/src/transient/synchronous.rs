@@ -261,9 +261,19 @@ impl History {
         }
         let i = self.t.partition_point(|&x| x <= t).clamp(1, n - 1);
         let (t0, w0) = (self.t[i - 1], self.w[i - 1]);
-        let (_, slope) = self.at(t);
+        let slope = self.slope(i);
         let d = t - t0;
         self.angle[i - 1] + w0 * d + 0.5 * slope * d * d
+    }
+
+    /// The speed's slope between points `i - 1` and `i` \[rad/s^2\].
+    fn slope(&self, i: usize) -> f64 {
+        let (t0, t1) = (self.t[i - 1], self.t[i]);
+        if t1 > t0 {
+            (self.w[i] - self.w[i - 1]) / (t1 - t0)
+        } else {
+            0.0
+        }
     }
 
     /// (w, w') at `t`.
@@ -273,9 +283,8 @@ impl History {
             return (self.w[0], 0.0);
         }
         let i = self.t.partition_point(|&x| x <= t).clamp(1, n - 1);
-        let (t0, t1, w0, w1) = (self.t[i - 1], self.t[i], self.w[i - 1], self.w[i]);
-        let slope = if t1 > t0 { (w1 - w0) / (t1 - t0) } else { 0.0 };
-        (w0 + slope * (t - t0), slope)
+        let slope = self.slope(i);
+        (self.w[i - 1] + slope * (t - self.t[i - 1]), slope)
     }
 }
 
