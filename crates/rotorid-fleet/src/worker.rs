@@ -291,6 +291,21 @@ pub async fn run(
                 continue;
             }
             Step::Recreate { start } => {
+                // another worker may have re-created it meanwhile: then it answers
+                let probe = tokio::select! {
+                    _ = &mut shutdown => break,
+                    p = probe_consumer(fleet, &cfg.durable) => p,
+                };
+                if let Probe::Alive { ack_floor } = probe {
+                    let now = tokio::time::Instant::now().into_std();
+                    watch.answered(now, Some(ack_floor));
+                    eprintln!(
+                        "worker: consumer {} of {RAW_STREAM} answers again",
+                        cfg.durable
+                    );
+                    continue;
+                }
+                let now = tokio::time::Instant::now().into_std();
                 eprintln!(
                     "worker: consumer {} of {RAW_STREAM} unanswered or gone for {} s; \
                      re-creating it from stream sequence {start} (windows after the last \
