@@ -139,16 +139,38 @@ impl Cluster {
     /// `dir/n<i>`, and wait until every node is up and JetStream has elected its meta
     /// leader with all `n` peers (a condition, for up to 60 s: a busy machine is slow).
     pub fn start(dir: &Path, n: usize) -> Self {
-        let ports: Vec<u16> = (0..n).map(|_| free_port()).collect();
-        let routes: Vec<u16> = (0..n).map(|_| free_port()).collect();
-        let monitors: Vec<u16> = (0..n).map(|_| free_port()).collect();
+        // a node that cannot bind its ports (taken meanwhile by another process) exits at
+        // once: start again on other ports rather than wait for a cluster that cannot form
+        let mut why = String::new();
+        for attempt in 0..3 {
+            match Self::try_start(&dir.join(format!("try{attempt}")), n) {
+                Ok(c) => return c,
+                Err(e) => why = e,
+            }
+        }
+        panic!("the nats-server cluster did not form: {why}");
+    }
+
+    fn try_start(dir: &Path, n: usize) -> Result<Self, String> {
+        // 3n distinct ports: every listener is held until all are chosen
+        let listeners: Vec<std::net::TcpListener> = (0..3 * n)
+            .map(|_| std::net::TcpListener::bind("127.0.0.1:0").expect("a free loopback port"))
+            .collect();
+        let port = |i: usize| listeners[i].local_addr().expect("its address").port();
+        let ports: Vec<u16> = (0..n).map(port).collect();
+        let routes: Vec<u16> = (n..2 * n).map(port).collect();
+        let monitors: Vec<u16> = (2 * n..3 * n).map(port).collect();
+        drop(listeners);
         let route_list = routes
             .iter()
             .map(|p| format!("nats://127.0.0.1:{p}"))
             .collect::<Vec<_>>()
             .join(",");
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let log = |i: usize| dir.join(format!("n{i}.log"));
         let mut children = Vec::new();
         for i in 0..n {
+            let err = std::fs::File::create(log(i)).map_err(|e| e.to_string())?;
             let child = Command::new(nats_server())
                 .args(["-js", "-a", "127.0.0.1", "-p"])
                 .arg(ports[i].to_string())
@@ -160,7 +182,7 @@ impl Cluster {
                 .arg(format!("nats://127.0.0.1:{}", routes[i]))
                 .args(["--routes", &route_list])
                 .stdout(Stdio::null())
-                .stderr(Stdio::null())
+                .stderr(err)
                 .spawn()
                 .expect(
                     "nats-server is not installed: `apt-get install -y nats-server` (.ci/test \
@@ -168,7 +190,7 @@ impl Cluster {
                 );
             children.push(Some(child));
         }
-        let c = Self { ports, children };
+        let mut c = Self { ports, children };
         let t = Instant::now();
         // every node is a member of the meta group and knows its leader
         let ready = |m: u16| {
@@ -178,14 +200,27 @@ impl Cluster {
                 (b.contains(&size) || b.contains(&size2)) && b.contains("\"leader\"")
             }) && monitor_get(m, "/healthz").is_some_and(|b| b.contains("ok"))
         };
+        let tail = |i: usize| {
+            let text = std::fs::read_to_string(log(i)).unwrap_or_default();
+            let lines: Vec<&str> = text.lines().collect();
+            lines[lines.len().saturating_sub(5)..].join("\n")
+        };
         while !monitors.iter().all(|&m| ready(m)) {
-            assert!(
-                t.elapsed() < Duration::from_secs(60),
-                "the nats-server cluster did not form"
-            );
+            for i in 0..n {
+                let exited = c.children[i]
+                    .as_mut()
+                    .is_some_and(|ch| ch.try_wait().ok().flatten().is_some());
+                if exited {
+                    return Err(format!("node n{i} exited:\n{}", tail(i)));
+                }
+            }
+            if t.elapsed() > Duration::from_secs(60) {
+                let logs: Vec<String> = (0..n).map(|i| format!("n{i}: {}", tail(i))).collect();
+                return Err(format!("not formed in 60 s:\n{}", logs.join("\n")));
+            }
             std::thread::sleep(Duration::from_millis(100));
         }
-        c
+        Ok(c)
     }
 
     /// The client URL of node `i`.

@@ -38,7 +38,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
-use async_nats::jetstream::consumer::{pull, PullConsumer};
+use async_nats::jetstream::consumer::{pull, DeliverPolicy, PullConsumer};
 use async_nats::jetstream::kv;
 use async_nats::jetstream::message::AckKind;
 use async_nats::jetstream::Message;
@@ -54,7 +54,7 @@ use crate::frame::{check_machine_id, Frame};
 use crate::nats::{retry, Fleet};
 use crate::result::{ErrorRecord, WindowResult, FLEET_SCHEMA};
 use crate::window::identify_frame;
-use crate::{alert_subject, error_subject, ident_subject, message_id};
+use crate::{alert_subject, error_subject, ident_subject, message_id, RAW_STREAM};
 
 /// Largest scenario or baseline file read \[bytes\].
 pub const MAX_FILE_BYTES: u64 = 1 << 20;
@@ -212,17 +212,29 @@ pub async fn prepare(fleet: &Fleet, cfg: &WorkerConfig) -> Result<PullConsumer, 
     fleet.alert_stream().await?;
     fleet.latest().await?;
     fleet.drift().await?;
-    let config = pull::Config {
-        durable_name: Some(cfg.durable.clone()),
-        ack_wait: cfg.ack_wait,
-        max_deliver: -1,
-        filter_subject: "rotorid.raw.>".into(),
-        ..Default::default()
-    };
+    let config = consumer_config(cfg, 0);
     retry(&format!("create consumer {}", cfg.durable), || {
         raw.get_or_create_consumer(&cfg.durable, config.clone())
     })
     .await
+}
+
+/// The workers' consumer, delivering from stream sequence `start` (0: from the first).
+fn consumer_config(cfg: &WorkerConfig, start: u64) -> pull::Config {
+    pull::Config {
+        durable_name: Some(cfg.durable.clone()),
+        ack_wait: cfg.ack_wait,
+        max_deliver: -1,
+        filter_subject: "rotorid.raw.>".into(),
+        deliver_policy: if start > 1 {
+            DeliverPolicy::ByStartSequence {
+                start_sequence: start,
+            }
+        } else {
+            DeliverPolicy::All
+        },
+        ..Default::default()
+    }
 }
 
 /// Run a worker until `shutdown` resolves (module doc).
@@ -231,7 +243,12 @@ pub async fn run(
     cfg: &WorkerConfig,
     shutdown: impl Future<Output = ()>,
 ) -> Result<WorkerStats, FleetError> {
-    let consumer = prepare(fleet, cfg).await?;
+    let mut consumer = prepare(fleet, cfg).await?;
+    let raw = fleet.raw_stream().await?;
+    let mut watch = ConsumerWatch::new(
+        tokio::time::Instant::now().into_std(),
+        consumer.cached_info().ack_floor.stream_sequence,
+    );
     let mut w = Worker {
         fleet,
         cfg,
@@ -243,14 +260,271 @@ pub async fn run(
     };
     tokio::pin!(shutdown);
     loop {
+        let now = tokio::time::Instant::now().into_std();
+        match watch.step(now) {
+            Step::Pull => {}
+            Step::Probe => {
+                let probe = tokio::select! {
+                    _ = &mut shutdown => break,
+                    p = probe_consumer(fleet, &cfg.durable) => p,
+                };
+                let now = tokio::time::Instant::now().into_std();
+                match probe {
+                    Probe::Alive { ack_floor } => watch.answered(now, Some(ack_floor)),
+                    Probe::Gone => {
+                        eprintln!(
+                            "worker: consumer {} of {RAW_STREAM} is gone; re-creating it",
+                            cfg.durable
+                        );
+                        watch.gone(now);
+                    }
+                    Probe::Unanswered(why) => {
+                        if watch.unanswered(now) {
+                            eprintln!(
+                                "worker: consumer {} of {RAW_STREAM} does not answer ({why}); \
+                                 asking again",
+                                cfg.durable
+                            );
+                        }
+                    }
+                }
+                continue;
+            }
+            Step::Recreate { start } => {
+                // another worker may have re-created it meanwhile: then it answers
+                let probe = tokio::select! {
+                    _ = &mut shutdown => break,
+                    p = probe_consumer(fleet, &cfg.durable) => p,
+                };
+                if let Probe::Alive { ack_floor } = probe {
+                    let now = tokio::time::Instant::now().into_std();
+                    watch.answered(now, Some(ack_floor));
+                    eprintln!(
+                        "worker: consumer {} of {RAW_STREAM} answers again",
+                        cfg.durable
+                    );
+                    continue;
+                }
+                let now = tokio::time::Instant::now().into_std();
+                eprintln!(
+                    "worker: consumer {} of {RAW_STREAM} unanswered or gone for {} s; \
+                     re-creating it from stream sequence {start} (windows after the last \
+                     acknowledged one may be done again, with the same result ids)",
+                    cfg.durable,
+                    watch.failing_for(now).as_secs()
+                );
+                let made = tokio::select! {
+                    _ = &mut shutdown => break,
+                    r = recreate_consumer(&raw, cfg, start) => r,
+                };
+                let now = tokio::time::Instant::now().into_std();
+                match made {
+                    Ok(c) => {
+                        consumer = c;
+                        watch.recreated(now, true);
+                        eprintln!(
+                            "worker: consumer {} of {RAW_STREAM} re-created; waiting for windows",
+                            cfg.durable
+                        );
+                    }
+                    Err(e) => {
+                        let pause = watch.recreated(now, false);
+                        eprintln!(
+                            "worker: re-creating consumer {} of {RAW_STREAM} failed ({e}); \
+                             trying again in {} s",
+                            cfg.durable,
+                            pause.as_secs_f64()
+                        );
+                    }
+                }
+                continue;
+            }
+        }
         let msg = tokio::select! {
             _ = &mut shutdown => break,
             m = next_message(&consumer) => m,
         };
         let Some(msg) = msg else { continue };
+        watch.answered(tokio::time::Instant::now().into_std(), None);
         w.handle(msg).await?;
     }
     Ok(w.stats)
+}
+
+/// How often a worker asks its consumer's leader how it is (and how far the windows are
+/// acknowledged), whether or not windows come.
+pub const PROBE_EVERY: Duration = Duration::from_secs(5);
+/// How long the consumer may stay unanswered (no leader: its replicas lost or an election
+/// that never ends) before the worker re-creates it.
+pub const UNANSWERED_FOR: Duration = Duration::from_secs(15);
+/// Longest pause between attempts to re-create the consumer.
+pub const RECREATE_BACKOFF_MAX: Duration = Duration::from_secs(30);
+
+/// What a probe of the consumer found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Probe {
+    /// Its leader answered; every window up to stream sequence `ack_floor` is acknowledged.
+    Alive {
+        /// The stream sequence of the acknowledgement floor.
+        ack_floor: u64,
+    },
+    /// The servers say there is no such consumer (deleted, or lost with its replicas).
+    Gone,
+    /// Nobody answered (no leader), or an error that is not "not found".
+    Unanswered(String),
+}
+
+/// What the worker does next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Step {
+    /// Pull the next window.
+    Pull,
+    /// Ask the consumer how it is.
+    Probe,
+    /// Delete and create the consumer again, delivering from stream sequence `start`.
+    Recreate {
+        /// The first stream sequence the new consumer delivers.
+        start: u64,
+    },
+}
+
+/// The worker's watch on its consumer: a worker never waits silently on a consumer that
+/// has no leader or no longer exists. It probes the consumer every [`PROBE_EVERY`]; when
+/// the consumer is gone, or unanswered for [`UNANSWERED_FOR`], it re-creates it from just
+/// after the last acknowledgement floor it saw (a window after it may be done again, which
+/// the results' message ids make harmless), retrying with a doubling pause up to
+/// [`RECREATE_BACKOFF_MAX`]. Pure (times are given), so that its decisions are tested
+/// without a server.
+#[derive(Debug, Clone)]
+pub struct ConsumerWatch {
+    last_probe: std::time::Instant,
+    failing_since: Option<std::time::Instant>,
+    gone: bool,
+    ack_floor: u64,
+    backoff: Duration,
+    next_attempt: Option<std::time::Instant>,
+}
+
+impl ConsumerWatch {
+    /// A watch on a consumer just created or bound at `now`, acknowledged up to `ack_floor`.
+    pub fn new(now: std::time::Instant, ack_floor: u64) -> Self {
+        Self {
+            last_probe: now,
+            failing_since: None,
+            gone: false,
+            ack_floor,
+            backoff: Duration::from_secs(1),
+            next_attempt: None,
+        }
+    }
+
+    /// What to do at `now`.
+    pub fn step(&self, now: std::time::Instant) -> Step {
+        if let Some(since) = self.failing_since {
+            let due = self.next_attempt.is_none_or(|t| now >= t);
+            if due && (self.gone || now.saturating_duration_since(since) >= UNANSWERED_FOR) {
+                return Step::Recreate {
+                    start: self.ack_floor + 1,
+                };
+            }
+        }
+        if now.saturating_duration_since(self.last_probe) >= PROBE_EVERY {
+            Step::Probe
+        } else {
+            Step::Pull
+        }
+    }
+
+    /// The consumer answered at `now` (a probe, with its acknowledgement floor, or a window).
+    pub fn answered(&mut self, now: std::time::Instant, ack_floor: Option<u64>) {
+        if let Some(f) = ack_floor {
+            self.ack_floor = self.ack_floor.max(f);
+            self.last_probe = now;
+        }
+        self.failing_since = None;
+        self.gone = false;
+        self.backoff = Duration::from_secs(1);
+        self.next_attempt = None;
+    }
+
+    /// A probe at `now` was not answered; true when this starts a spell of failures.
+    pub fn unanswered(&mut self, now: std::time::Instant) -> bool {
+        self.last_probe = now;
+        let first = self.failing_since.is_none();
+        self.failing_since.get_or_insert(now);
+        first
+    }
+
+    /// A probe at `now` found no such consumer.
+    pub fn gone(&mut self, now: std::time::Instant) {
+        self.unanswered(now);
+        self.gone = true;
+    }
+
+    /// How long the consumer has been failing at `now`.
+    pub fn failing_for(&self, now: std::time::Instant) -> Duration {
+        self.failing_since
+            .map_or(Duration::ZERO, |t| now.saturating_duration_since(t))
+    }
+
+    /// A re-creation ended at `now`; when it failed, returns the pause before the next one.
+    pub fn recreated(&mut self, now: std::time::Instant, ok: bool) -> Duration {
+        if ok {
+            self.answered(now, None);
+            self.last_probe = now;
+            return Duration::ZERO;
+        }
+        let pause = self.backoff;
+        self.last_probe = now;
+        self.next_attempt = Some(now + pause);
+        self.backoff = (self.backoff * 2).min(RECREATE_BACKOFF_MAX);
+        pause
+    }
+}
+
+/// Ask the consumer's leader for its state (answered by the leader only: a consumer
+/// without one does not answer).
+async fn probe_consumer(fleet: &Fleet, durable: &str) -> Probe {
+    use async_nats::jetstream::response::Response;
+    let subject = format!("CONSUMER.INFO.{RAW_STREAM}.{durable}");
+    match fleet
+        .js
+        .request::<_, _, Response<async_nats::jetstream::consumer::Info>>(
+            subject,
+            &serde_json::json!({}),
+        )
+        .await
+    {
+        Ok(Response::Ok(info)) => Probe::Alive {
+            ack_floor: info.ack_floor.stream_sequence,
+        },
+        Ok(Response::Err { error })
+            if error.error_code() == async_nats::jetstream::ErrorCode::CONSUMER_NOT_FOUND =>
+        {
+            Probe::Gone
+        }
+        Ok(Response::Err { error }) => Probe::Unanswered(error.to_string()),
+        Err(e) => Probe::Unanswered(e.to_string()),
+    }
+}
+
+/// Delete the consumer (its state went with its leader) and create it again, delivering
+/// from stream sequence `start`; a consumer another worker made meanwhile is bound instead.
+async fn recreate_consumer(
+    raw: &async_nats::jetstream::stream::Stream,
+    cfg: &WorkerConfig,
+    start: u64,
+) -> Result<PullConsumer, String> {
+    use async_nats::jetstream::stream::ConsumerErrorKind;
+    match raw.delete_consumer(&cfg.durable).await {
+        // deleted, or the servers answered (e.g. it is gone already)
+        Ok(_) => {}
+        Err(e) if matches!(e.kind(), ConsumerErrorKind::JetStream(_)) => {}
+        Err(e) => return Err(format!("delete: {e}")),
+    }
+    raw.get_or_create_consumer(&cfg.durable, consumer_config(cfg, start))
+        .await
+        .map_err(|e| format!("create: {e}"))
 }
 
 /// The next window, or `None` after a pull that expired or failed (the server may be
@@ -603,5 +877,70 @@ async fn ack(msg: &Message) {
             return;
         }
         tokio::time::sleep(Duration::from_millis(200)).await;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Instant;
+
+    fn at(t0: Instant, s: f64) -> Instant {
+        t0 + Duration::from_secs_f64(s)
+    }
+
+    #[test]
+    fn a_healthy_consumer_is_pulled_from_and_probed_now_and_then() {
+        let t0 = Instant::now();
+        let mut w = ConsumerWatch::new(t0, 7);
+        assert_eq!(w.step(at(t0, 1.0)), Step::Pull);
+        assert_eq!(w.step(at(t0, 5.0)), Step::Probe);
+        w.answered(at(t0, 5.1), Some(12));
+        assert_eq!(w.step(at(t0, 6.0)), Step::Pull);
+        // windows arriving do not stop the probes (they keep the floor recent)
+        w.answered(at(t0, 9.0), None);
+        assert_eq!(w.step(at(t0, 10.2)), Step::Probe);
+    }
+
+    #[test]
+    fn an_unanswered_consumer_is_recreated_after_the_floor_it_had_and_not_before() {
+        let t0 = Instant::now();
+        let mut w = ConsumerWatch::new(t0, 3);
+        w.answered(at(t0, 5.0), Some(9));
+        assert!(w.unanswered(at(t0, 15.0)), "a spell of failures starts");
+        assert_eq!(w.step(at(t0, 16.0)), Step::Pull);
+        assert_eq!(w.step(at(t0, 20.0)), Step::Probe);
+        assert!(!w.unanswered(at(t0, 25.0)), "the same spell");
+        assert_eq!(w.step(at(t0, 29.9)), Step::Pull, "not yet 15 s unanswered");
+        // 15 s unanswered: re-create from just after the floor
+        assert_eq!(w.step(at(t0, 30.0)), Step::Recreate { start: 10 });
+        assert_eq!(w.failing_for(at(t0, 30.0)), Duration::from_secs(15));
+        // a probe answering in between ends the spell
+        w.answered(at(t0, 30.0), Some(11));
+        assert_eq!(w.step(at(t0, 31.0)), Step::Pull);
+        assert_eq!(w.failing_for(at(t0, 31.0)), Duration::ZERO);
+    }
+
+    #[test]
+    fn a_gone_consumer_is_recreated_at_once_and_failures_back_off() {
+        let t0 = Instant::now();
+        let mut w = ConsumerWatch::new(t0, 0);
+        w.gone(at(t0, 5.0));
+        assert_eq!(w.step(at(t0, 5.0)), Step::Recreate { start: 1 });
+        let pauses: Vec<f64> = (0..7)
+            .map(|i| {
+                w.recreated(at(t0, 10.0 * f64::from(i)), false)
+                    .as_secs_f64()
+            })
+            .collect();
+        assert_eq!(pauses, [1.0, 2.0, 4.0, 8.0, 16.0, 30.0, 30.0]);
+        // not again before the pause is over
+        assert_ne!(w.step(at(t0, 60.0 + 29.0)), Step::Recreate { start: 1 });
+        assert_eq!(w.step(at(t0, 90.0)), Step::Recreate { start: 1 });
+        assert_eq!(w.recreated(at(t0, 91.0), true), Duration::ZERO);
+        assert_eq!(w.step(at(t0, 92.0)), Step::Pull);
+        // the next spell starts from a short pause again
+        w.gone(at(t0, 100.0));
+        assert_eq!(w.recreated(at(t0, 100.0), false), Duration::from_secs(1));
     }
 }

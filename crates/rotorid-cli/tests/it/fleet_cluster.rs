@@ -419,3 +419,106 @@ fn a_three_node_cluster_loses_the_raw_leader_mid_run_without_a_window_lost_or_re
         (!on.contains(&format!("(server {leader})"))).then_some(())
     });
 }
+
+/// A worker whose consumer loses its only replica (an R1 consumer, as made by hand or by an
+/// older fleet, on the node that dies) says so and re-creates the consumer, then identifies
+/// the windows published afterwards: it does not wait silently for ever.
+#[test]
+fn a_worker_whose_consumer_has_no_leader_left_recreates_it_and_carries_on() {
+    use async_nats::jetstream::consumer::pull;
+    let dir = tempfile::tempdir().unwrap();
+    let mut cluster = Cluster::start(&dir.path().join("cluster"), 3);
+    let all = cluster.urls();
+    let rt = rt();
+    // the raw stream with 3 replicas, the workers' consumer with 1
+    let holder = rt.block_on(async {
+        let fleet = Fleet::connect(&all, Duration::from_secs(10))
+            .await
+            .unwrap()
+            .with_replicas(3)
+            .unwrap();
+        let raw = fleet.raw_stream().await.unwrap();
+        let mut c = raw
+            .create_consumer(pull::Config {
+                durable_name: Some(rotorid_fleet::DEFAULT_DURABLE.into()),
+                filter_subject: "rotorid.raw.>".into(),
+                ack_wait: Duration::from_secs(2),
+                num_replicas: 1,
+                ..Default::default()
+            })
+            .await
+            .unwrap();
+        let info = c.info().await.unwrap();
+        info.cluster.as_ref().unwrap().leader.clone().unwrap()
+    });
+    raw_leader(&rt, &all, 3);
+    let dead = cluster.index_of(&holder).expect("a node of ours holds it");
+    let live = (0..3)
+        .filter(|&i| i != dead)
+        .map(|i| cluster.url(i))
+        .collect::<Vec<_>>()
+        .join(",");
+    let log = dir.path().join("worker.log");
+    let _worker = Proc(Some(
+        Command::new(assert_cmd::cargo::cargo_bin("rotorid"))
+            .args(["worker", "--nats", &live, "--replicas", "3"])
+            .args(["--scenario", "table1", "--ack-wait", "2", "-v"])
+            .stdout(Stdio::null())
+            .stderr(std::fs::File::create(&log).unwrap())
+            .spawn()
+            .unwrap(),
+    ));
+    let read_log = || std::fs::read_to_string(&log).unwrap_or_default();
+    wait_for("the worker on its consumer", || {
+        read_log().contains("waiting for windows").then_some(())
+    });
+    cluster.kill(dead);
+
+    let rec = dir.path().join("m.csv");
+    run(&[
+        "simulate",
+        "--scenario",
+        "table1",
+        "--duration",
+        "1",
+        "--snr-db",
+        "40",
+        "--seed",
+        "91",
+        "--out",
+        rec.to_str().unwrap(),
+        "-q",
+    ]);
+    run(&[
+        "publish",
+        rec.to_str().unwrap(),
+        "--nats",
+        &live,
+        "--machine",
+        "m-0",
+        "--window-s",
+        "0.25",
+        "--replicas",
+        "3",
+    ]);
+    wait_for(
+        "every window's result after the consumer was re-created",
+        || {
+            rt.block_on(async {
+                let fleet = Fleet::connect(&live, Duration::from_secs(10)).await.ok()?;
+                let mut s = fleet
+                    .js
+                    .get_stream(rotorid_fleet::IDENT_STREAM)
+                    .await
+                    .ok()?;
+                (s.info().await.ok()?.state.messages == WINDOWS).then_some(())
+            })
+        },
+    );
+    let text = read_log();
+    assert!(
+        text.contains("re-creating it from stream sequence")
+            && text.contains("re-created; waiting for windows"),
+        "{text}"
+    );
+}
