@@ -198,7 +198,7 @@ fn best(ev: &[(f64, f64)]) -> Smoothed {
 
 /// Knots (periodic, evenly spaced) of the piecewise-linear function of the sampling phase
 /// in the model of the events' timing bias.
-const PHASE_KNOTS: usize = 16;
+pub const PHASE_KNOTS: usize = 16;
 
 /// The sampling interval of `t` \[s\] when its samples are evenly spaced (each step
 /// within 1e-6 of the mean step), else `None`.
