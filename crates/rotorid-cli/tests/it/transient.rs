@@ -102,6 +102,41 @@ fn run_transient(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// `rotorid simulate --raw` of `sc` to `DIR/name` (its slow roll to `DIR/slow.csv`), then
+/// `rotorid transient` of it into `DIR/res` with `extra` arguments: (stdout, the results'
+/// folder, transient.json).
+fn simulate_and_analyse(
+    dir: &Path,
+    sc: &str,
+    name: &str,
+    extra: &[&str],
+) -> (String, std::path::PathBuf, Value) {
+    let raw = dir.join(name);
+    let slow = dir.join("slow.csv");
+    let out = rotorid()
+        .args(["simulate", "--scenario", sc, "--raw", "-q", "--out"])
+        .arg(&raw)
+        .arg("--slow-roll-out")
+        .arg(&slow)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let res = dir.join("res");
+    let mut args = vec![raw.to_str().unwrap(), "--scenario", sc];
+    args.extend(extra);
+    args.extend(["--out", res.to_str().unwrap()]);
+    let (ok, stdout, stderr) = run_transient(&args);
+    assert!(ok, "{stderr}");
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(res.join("transient.json")).unwrap())
+            .unwrap();
+    (stdout, res, json)
+}
+
 /// A bode.csv row: (speed_rpm, sensor, order, re, im, std, raw_re, raw_im).
 type BodeRow = (f64, String, u32, f64, f64, f64, f64, f64);
 
@@ -172,35 +207,13 @@ fn run_up_criticals_amplification_factors_and_margins_match_the_steady_state() {
     let dir = tempfile::tempdir().unwrap();
     // 300 rpm + 25 rad/s^2 for 36 s: to 8894 rpm, through both criticals
     let sc = scenario(dir.path(), 300.0, 25.0, 36.0);
-    let raw = dir.path().join("runup.csv");
-    let slow = dir.path().join("slow.csv");
-    let out = rotorid()
-        .args(["simulate", "--scenario", &sc, "--raw", "-q", "--out"])
-        .arg(&raw)
-        .arg("--slow-roll-out")
-        .arg(&slow)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let res = dir.path().join("res");
-    let (ok, stdout, stderr) = run_transient(&[
-        raw.to_str().unwrap(),
-        "--scenario",
+    let (stdout, res, json) = simulate_and_analyse(
+        dir.path(),
         &sc,
-        "--operating-rpm",
-        "3000:4500",
-        "--out",
-        res.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
+        "runup.csv",
+        &["--operating-rpm", "3000:4500"],
+    );
     assert!(stdout.contains("run-up"), "{stdout}");
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(res.join("transient.json")).unwrap())
-            .unwrap();
     assert_eq!(json["direction"], "run_up");
     for (sensor, angle) in [("probe_L", 135.0), ("probe_R", 45.0)] {
         let truth = steady_criticals(angle);
@@ -312,33 +325,8 @@ fn a_coast_down_from_steady_state_has_its_criticals_below_the_steady_ones_and_th
     // 8900 rpm - 25 rad/s^2 for 34 s: to 783 rpm, through both criticals
     let sc = scenario(dir.path(), 8900.0, -25.0, 34.0);
     start_steady(&sc, 8900.0);
-    let raw = dir.path().join("coast.csv");
-    let slow = dir.path().join("slow.csv");
-    let out = rotorid()
-        .args(["simulate", "--scenario", &sc, "--raw", "-q", "--out"])
-        .arg(&raw)
-        .arg("--slow-roll-out")
-        .arg(&slow)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let res = dir.path().join("res");
-    let (ok, stdout, stderr) = run_transient(&[
-        raw.to_str().unwrap(),
-        "--scenario",
-        &sc,
-        "--out",
-        res.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
+    let (stdout, res, json) = simulate_and_analyse(dir.path(), &sc, "coast.csv", &[]);
     assert!(stdout.contains("coast-down"), "{stdout}");
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(res.join("transient.json")).unwrap())
-            .unwrap();
     assert_eq!(json["direction"], "coast_down");
     let rows = bode_rows(&res);
     for (sensor, angle) in [("probe_L", 135.0), ("probe_R", 45.0)] {
