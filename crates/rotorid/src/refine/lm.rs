@@ -276,9 +276,11 @@ fn natural_frequency(t: &Theta) -> f64 {
 }
 
 /// Samples in the first window: FIRST_WINDOW_PERIODS periods of sqrt(k/m), at least 50
-/// per unknown, at most the record. Two periods keep a start up to ~8 % off in w_n within
-/// one radian of phase; the next window then usually reaches the whole record.
-fn first_window(t: &Theta, dt: f64, samples: usize, unknowns: usize) -> usize {
+/// per unknown (of a record `stride` times as dense: the same time span when the record
+/// is every `stride`-th sample of another), at most the record. Two periods keep a start
+/// up to ~8 % off in w_n within one radian of phase; the next window then usually reaches
+/// the whole record.
+fn first_window(t: &Theta, dt: f64, samples: usize, unknowns: usize, stride: usize) -> usize {
     let w = natural_frequency(t);
     let n = if w > 0.0 {
         (FIRST_WINDOW_PERIODS * std::f64::consts::TAU / w / dt).ceil()
@@ -286,7 +288,9 @@ fn first_window(t: &Theta, dt: f64, samples: usize, unknowns: usize) -> usize {
         samples as f64
     };
     let n = if n.is_finite() { n as usize } else { samples };
-    n.max(50 * unknowns).min(samples)
+    n.max((50 * unknowns).div_ceil(stride.max(1)))
+        .max(unknowns)
+        .min(samples)
 }
 
 /// The next window: as long as the free vibration's phase stays predictable,
@@ -326,26 +330,24 @@ fn next_window(
     grow.max(2 * n_used).min(samples)
 }
 
-/// Fit the model to the record by maximum likelihood, starting from `start` (rotor
-/// parameters; e.g. the algebraic identifier's estimate) and `start_initial` (the
-/// initial-state guess, or its known value when `options.unknowns.initial_state` is
-/// false). Quantities not selected as unknown keep their starting values.
-///
-/// The fit runs on a growing window of the record (a continuation that keeps the start
-/// inside the basin of the global optimum): first two periods of the natural frequency,
-/// then as long a stretch as the current uncertainty of the natural frequencies allows
-/// (3-sigma phase error <= 1 rad), finally the whole record. A negative starting damping
-/// of an unknown cx or cz is raised to 0 (negative damping makes the model response grow
-/// exponentially).
-///
-/// Errors only on unusable input; an unidentifiable problem returns `Ok` with
-/// `identifiable == false`, warnings and infinite standard errors.
-pub fn refine(
+/// The continuation's end: the discrete model, the columns, the start (after the damping
+/// clamp) and the last window's outcome on the whole record.
+struct Continued {
+    disc: Discrete,
+    cols: Columns,
+    theta0: Theta,
+    out: Outcome,
+    passes: usize,
+}
+
+/// The fit of [`refine`] without what it reports besides the estimate (module doc).
+fn continuation(
     record: &Record,
     start: &RotorParams,
     start_initial: &InitialState,
     options: &RefineOptions,
-) -> Result<Refined, RefineError> {
+    how: &Continuation,
+) -> Result<Continued, RefineError> {
     record.validate()?;
     check_params(start)?;
     start_initial.validated()?;
@@ -373,12 +375,13 @@ pub fn refine(
         theta.cz = theta.cz.max(0.0);
     }
     let disc = Discrete::new(&record.experiment(), options.discretisation, &theta)?;
+    let disc = if how.balanced { disc.balanced() } else { disc };
 
     let dt = record.dt;
     let mut n_used = if options.max_iterations == 0 {
         samples
     } else {
-        first_window(&theta, dt, samples, cols.n)
+        first_window(&theta, dt, samples, cols.n, how.stride)
     };
     theta = solve_linear(&disc, record, &cols, &theta, n_used);
     let mut passes = 0;
@@ -387,7 +390,7 @@ pub fn refine(
         let tol = if last {
             options.tolerance
         } else {
-            WINDOW_TOLERANCE
+            how.window_tolerance
         };
         let mut budget = options.max_iterations.saturating_sub(passes);
         if !last {
@@ -407,6 +410,120 @@ pub fn refine(
         }
         n_used = next_window(&out.fisher, &cols, &theta, n_used, dt, samples);
     };
+    Ok(Continued {
+        disc,
+        cols,
+        theta0,
+        out,
+        passes,
+    })
+}
+
+/// The maximum-likelihood estimate alone and the model's response there: what the
+/// adequacy test needs (`pipeline::adequacy`), without the covariances, the sandwich and
+/// the transient's significance that [`refine`] adds.
+pub(crate) struct Fit {
+    /// The fitted rotor.
+    pub rotor: RotorParams,
+    /// The fitted initial state.
+    pub initial: InitialState,
+    /// Whether the last step was below the tolerance.
+    pub converged: bool,
+    /// Model passes with sensitivities.
+    pub passes: usize,
+    /// The model's x, z at the record's samples \[m\].
+    pub x: Vec<f64>,
+    /// The model's z.
+    pub z: Vec<f64>,
+}
+
+/// How the continuation runs besides [`RefineOptions`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Continuation {
+    /// The record is every `stride`-th sample of another: the first window spans the time
+    /// it would span there.
+    pub stride: usize,
+    /// Step tolerance on the windows before the whole record \[standard errors\].
+    pub window_tolerance: f64,
+    /// Exact steps on the balanced state (`Discrete::balanced`).
+    pub balanced: bool,
+}
+
+impl Default for Continuation {
+    fn default() -> Self {
+        Self {
+            stride: 1,
+            window_tolerance: WINDOW_TOLERANCE,
+            balanced: false,
+        }
+    }
+}
+
+/// [`refine`]'s estimate alone (see [`Fit`]).
+pub(crate) fn fit(
+    record: &Record,
+    start: &RotorParams,
+    start_initial: &InitialState,
+    options: &RefineOptions,
+    how: &Continuation,
+) -> Result<Fit, RefineError> {
+    let c = continuation(record, start, start_initial, options, how)?;
+    let theta = c.out.point.theta;
+    let samples = record.x.len();
+    let mut rotor = theta.params_with(start);
+    if !options.unknowns.unbalance {
+        rotor.unbalance = start.unbalance;
+    }
+    let none = Columns::new(&Unknowns::from_parameters(&[], false), rotor.model());
+    let mut sink = super::sweep::ResponseSink {
+        x: Vec::with_capacity(samples),
+        z: Vec::with_capacity(samples),
+    };
+    c.disc.run(&theta, &none, samples, &mut sink);
+    Ok(Fit {
+        rotor,
+        initial: theta.initial(),
+        converged: c.out.converged,
+        passes: c.passes,
+        x: sink.x,
+        z: sink.z,
+    })
+}
+
+/// Fit the model to the record by maximum likelihood, starting from `start` (rotor
+/// parameters; e.g. the algebraic identifier's estimate) and `start_initial` (the
+/// initial-state guess, or its known value when `options.unknowns.initial_state` is
+/// false). Quantities not selected as unknown keep their starting values.
+///
+/// The fit runs on a growing window of the record (a continuation that keeps the start
+/// inside the basin of the global optimum): first two periods of the natural frequency,
+/// then as long a stretch as the current uncertainty of the natural frequencies allows
+/// (3-sigma phase error <= 1 rad), finally the whole record. A negative starting damping
+/// of an unknown cx or cz is raised to 0 (negative damping makes the model response grow
+/// exponentially).
+///
+/// Errors only on unusable input; an unidentifiable problem returns `Ok` with
+/// `identifiable == false`, warnings and infinite standard errors.
+pub fn refine(
+    record: &Record,
+    start: &RotorParams,
+    start_initial: &InitialState,
+    options: &RefineOptions,
+) -> Result<Refined, RefineError> {
+    let Continued {
+        disc,
+        cols,
+        theta0,
+        out,
+        passes,
+    } = continuation(
+        record,
+        start,
+        start_initial,
+        options,
+        &Continuation::default(),
+    )?;
+    let samples = record.x.len();
     let cur = out.point;
     let (converged, last_step, iterations) = (out.converged, out.last_step, passes);
 

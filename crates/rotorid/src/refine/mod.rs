@@ -76,6 +76,7 @@ mod unknowns;
 pub use crb::{crb, crb_at_snr, model_response, ModelResponse};
 pub use discretisation::Discretisation;
 pub use error::RefineError;
+pub(crate) use lm::{fit, Continuation, Fit};
 pub use lm::{refine, RefineOptions};
 pub use record::{Experiment, Record, SpeedData};
 pub use result::{
