@@ -133,6 +133,19 @@ pub enum Finding {
         /// The residual's dominant frequency \[Hz\].
         dominant_frequency_hz: Option<f64>,
     },
+    /// A channel whose residuals fail the adequacy tests but stay below 1e-4 of the
+    /// signal's RMS (see `adequacy`): a record almost without noise, its values kept (a
+    /// note).
+    SmallResidual {
+        /// The channel.
+        direction: Direction,
+        /// Residual RMS over the signal's RMS.
+        relative_residual: f64,
+        /// Residual RMS \[m\].
+        residual_sigma_m: f64,
+        /// The data's white-noise level from its fourth differences \[m\].
+        noise_sigma_m: f64,
+    },
     /// An estimate outside the model's physical range (m or k <= 0, c < 0): withheld.
     NotPhysical {
         /// The parameter.
@@ -364,6 +377,22 @@ fn message(f: &Finding) -> String {
             dominant_frequency_hz.map_or(String::new(), |f| format!(
                 "; dominant residual frequency {f:.1} Hz"
             ))
+        ),
+        Finding::SmallResidual {
+            direction,
+            relative_residual,
+            residual_sigma_m,
+            noise_sigma_m,
+        } => format!(
+            "{}: the model reproduces the record to {relative_residual:.1e} of its RMS \
+             (residual {residual_sigma_m:.2e} m), though {:.0}x the data's noise level \
+             ({noise_sigma_m:.1e} m): a record almost without noise (a simulation, or a \
+             file's rounding). The values are kept: the test rules out any unmodelled effect \
+             above about {relative_residual:.0e} of the signal, but without noise to compare \
+             with it cannot tell a smaller one from the record's own numerical error (an \
+             integrator's period error, rounding), and no standard error covers that residual",
+            direction.name(),
+            residual_sigma_m / noise_sigma_m,
         ),
         Finding::NotPhysical { parameter, value } => format!(
             "{parameter} = {value:.4e} {} is not physical (m and k must be > 0, c >= 0): \

@@ -36,7 +36,8 @@ mod start;
 
 pub(crate) use adequacy::channel as channel_adequacy;
 pub use adequacy::{
-    Adequacy, ChannelAdequacy, ADEQUACY_P_MIN, LJUNG_BOX_LAGS, NOISE_RATIO_MAX, RESIDUAL_FLOOR,
+    Adequacy, AdequacyBasis, ChannelAdequacy, Refit, ADEQUACY_P_MIN, LJUNG_BOX_LAGS,
+    NOISE_RATIO_MAX, REFIT_SAMPLES, REFIT_SAMPLES_PER_PERIOD, RESIDUAL_FLOOR, SMALL_RESIDUAL_MAX,
 };
 pub use consistency::SPEED_FACTOR_TOLERANCE;
 pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};
@@ -124,6 +125,18 @@ pub fn identify(
         ..ident.record
     };
     Ok(ident)
+}
+
+/// Whether eq. (1) explains `record`, judged as the modulating and algebraic methods judge
+/// their estimates (docs/method.md section 6.4): the model refitted by maximum likelihood
+/// from `rotor` (m, the direct and cross-coupled coefficients and the initial state
+/// unknown; a and the unbalance as given) over every `stride`-th sample
+/// ([`REFIT_SAMPLES`]), its residuals through the whiteness and level tests.
+pub fn adequacy_of(
+    record: &Record,
+    rotor: &crate::model::RotorParams,
+) -> Result<Adequacy, PipelineError> {
+    adequacy::of_model(record, rotor)
 }
 
 /// The note of a record whose stamps were accepted because rounding to `resolution` \[s\]

@@ -362,6 +362,7 @@ fn fit(
             diagnostics.insert(0, d);
         }
     }
+    diagnostics.extend(adequacy.iter().flat_map(Adequacy::notes));
     diagnostics.extend(super::plausibility::Magnitudes::of(rec.x(), rec.z()).findings());
     let inadequate = adequacy.is_some_and(|a| !a.model_adequate);
     let inseparable = diagnostics.iter().any(Diagnostic::inseparable) || inadequate;

@@ -240,6 +240,10 @@ enum Engine {
         keep: Option<Vec<SampleEstimate>>,
         /// The first [`ALGEBRAIC_ADEQUACY_SAMPLES`] samples, for the adequacy test.
         kept: Kept,
+        /// Each direction's last usable estimate in the record's first
+        /// [`ALGEBRAIC_START_S`](super::ALGEBRAIC_START_S): the adequacy refit's start when
+        /// the estimates do not settle.
+        early: Box<EarlyEstimate>,
     },
     Modulating {
         id: ModulatingEngine,
@@ -263,6 +267,51 @@ pub const MODULATING_CRB_MAX_SAMPLES: usize = 2_000_000;
 /// record's first this many samples (5 columns of 8 bytes: 0.66 MB; 1.6 s at 10 kHz): its
 /// memory stays bounded (a streamed identify of any length peaks under 16 MiB).
 pub const ALGEBRAIC_ADEQUACY_SAMPLES: usize = 1 << 14;
+
+/// Each direction's last well-conditioned, finite algebraic estimate among the samples
+/// up to `last` (the record's first [`ALGEBRAIC_START_S`](super::ALGEBRAIC_START_S)), as
+/// refine's algebraic start takes it (docs/method.md section 5.2).
+#[derive(Debug)]
+struct EarlyEstimate {
+    last: usize,
+    values: [Option<[f64; 10]>; 2],
+}
+
+impl EarlyEstimate {
+    fn new(dt: f64) -> Self {
+        Self {
+            last: (super::ALGEBRAIC_START_S / dt)
+                .floor()
+                .min(usize::MAX as f64) as usize,
+            values: [None, None],
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, i: usize, e: &SampleEstimate) {
+        if i > self.last {
+            return;
+        }
+        let v = e.values();
+        let half = v.len() / 2;
+        for d in 0..2 {
+            let row = &v[d * half..(d + 1) * half];
+            if e.well_conditioned[d] && row.iter().all(|x| x.is_finite()) {
+                self.values[d] = Some(e.values);
+            }
+        }
+    }
+
+    /// The per-direction values (x's row from x's estimate, z's from z's), when both
+    /// directions had one.
+    fn values(&self, n: usize) -> Option<Vec<f64>> {
+        let [Some(x), Some(z)] = self.values else {
+            return None;
+        };
+        let half = n / 2;
+        Some(x[..half].iter().chain(&z[half..n]).copied().collect())
+    }
+}
 
 /// Samples kept for a computation over the whole record.
 #[derive(Debug, Default)]
@@ -566,6 +615,7 @@ impl Session {
                     last: None,
                     keep: self.keep.then(Vec::new),
                     kept: Kept::default(),
+                    early: Box::new(EarlyEstimate::new(grid.dt)),
                 }
             }
             Method::Modulating(s) => Engine::Modulating {
@@ -624,10 +674,12 @@ impl Session {
                 last,
                 keep,
                 kept,
+                early,
             } => {
                 let e = id.push(&m, s.t.unwrap_or(tg), settings.rcond_min)?;
                 if kept.t.len() < ALGEBRAIC_ADEQUACY_SAMPLES {
                     kept.push(s.t.unwrap_or(tg), s);
+                    early.push(i, &e);
                 }
                 let ok = e.well_conditioned;
                 flagged.x += u64::from(!ok[0]);
@@ -693,6 +745,7 @@ impl Session {
                 last,
                 keep,
                 kept,
+                early,
             } => {
                 if self.done < self.least() {
                     return Err(self.too_few(self.done));
@@ -708,16 +761,26 @@ impl Session {
                     id.windows(),
                 );
                 ident.estimates = keep.unwrap_or_default();
-                // judged only when its estimates settled: a refit from the late values of
-                // a noisy record starts from noise (module `adequacy`)
+                // refitted from the settled values; when they did not settle (on noisy
+                // records the late values are noise), from the early estimate refine's
+                // start policy takes (module `adequacy`)
                 let settled = !ident
                     .diagnostics
                     .iter()
                     .any(|d| matches!(d.finding, Finding::AlgebraicUnsettled { .. }));
-                if settled {
-                    if let Ok(rec) = self.record(kept, grid) {
-                        super::adequacy::judge(&mut ident, &rec, &self.knowledge);
-                    }
+                let model = ident.model;
+                let start = if settled && ident.rotor.is_some() {
+                    model
+                        .per_direction()
+                        .iter()
+                        .map(|&p| ident.value(p))
+                        .collect::<Option<Vec<f64>>>()
+                } else {
+                    early.values(model.per_direction().len())
+                }
+                .and_then(|v| super::adequacy::start_from(&self.knowledge, model, &v));
+                if let (Some(start), Ok(rec)) = (start, self.record(kept, grid)) {
+                    super::adequacy::judge_from(&mut ident, &rec, &start);
                 }
                 ident
             }

@@ -9,7 +9,10 @@
 //! 100-seed studies and prints the rates.
 
 use rotorid::model::{InitialState, Rotor, Sampling, SpeedProfile};
-use rotorid::pipeline::{identify, Finding, Identification, Knowledge, Method, Record, Speed};
+use rotorid::pipeline::{
+    identify, AdequacyBasis, Finding, Identification, Knowledge, Method, Record, Severity, Speed,
+    NOISE_RATIO_MAX, SMALL_RESIDUAL_MAX,
+};
 use rotorid::simulate::{add_noise, TimeResponse};
 use rotorid::test_models::{table1, TestModel};
 use rotorid::Scenario;
@@ -323,29 +326,125 @@ fn algebraic_verdict(
 }
 
 #[test]
-fn the_algebraic_method_is_judged_where_its_estimates_settle() {
-    // noise-free: the model itself passes (its residuals are at the model's own accuracy),
-    // the foundation is flagged whenever the estimates settle; at 40 dB the algebraic
-    // estimates never settle (algebraic_unsettled), and nothing is judged
+fn the_algebraic_method_is_judged_whether_its_estimates_settle_or_not() {
+    // noise-free: the model itself passes (its residuals are at the model's own
+    // accuracy); at 40 dB the algebraic estimates never settle (algebraic_unsettled) and
+    // the refit starts from the early estimate refine's start policy takes: judged, passes
     let m = table1();
     assert_eq!(
         algebraic_verdict(&m.clean, &m.scenario, f64::INFINITY, 0),
         (true, false)
     );
-    let (judged, flagged) = algebraic_verdict(
-        &simulate_defective(DEFECTS[1]),
-        &Scenario::table1(),
-        f64::INFINITY,
-        0,
-    );
-    assert!(
-        !judged || flagged,
-        "a settled estimate of the wrong model passed"
-    );
     assert_eq!(
         algebraic_verdict(&m.clean, &m.scenario, 40.0, 1),
-        (false, false)
+        (true, false)
     );
+}
+
+/// Whether `id` warns that the algebraic estimates did not settle.
+fn unsettled(id: &Identification) -> bool {
+    id.diagnostics
+        .iter()
+        .any(|d| matches!(d.finding, Finding::AlgebraicUnsettled { .. }))
+}
+
+#[test]
+fn the_algebraic_method_calls_a_wrong_model_inadequate_though_its_estimates_never_settle() {
+    // the rotor on a foundation eq. (1) lacks, clean: the algebraic estimates never
+    // settle (m_x ~15.1 kg, kx ~7.5e5 N/m against 14.29 kg and 1.195e6 N/m) and were
+    // reported as values with only that warning; the refit from the early estimate
+    // rejects the model, as every other method does
+    let c = simulate_defective(DEFECTS[1]);
+    let k = Knowledge::from_scenario(&Scenario::table1());
+    let id = identify(
+        &Record::from_response(&c).unwrap(),
+        &k,
+        &Method::algebraic(),
+    )
+    .unwrap();
+    assert!(unsettled(&id), "{:?}", id.diagnostics);
+    assert!(flagged(&id), "{:?}", id.adequacy);
+    assert!(matches!(
+        id.diagnostics[0].finding,
+        Finding::ModelInadequate { .. }
+    ));
+    // the raw numbers stay in `estimate`
+    assert!(id.parameters.iter().all(|p| p.estimate.is_some()));
+    // and with noise
+    for seed in 0..3 {
+        let id = run(
+            &Method::algebraic(),
+            &c,
+            &Scenario::table1(),
+            40.0,
+            40 + seed,
+        );
+        assert!(
+            unsettled(&id) && flagged(&id),
+            "seed {seed}: {:?}",
+            id.adequacy
+        );
+    }
+}
+
+#[test]
+fn a_noise_free_record_keeps_its_values_with_a_note_on_what_the_test_cannot_tell() {
+    // the paper's rotor through the paper's Newmark integrator, noise-free: eq. (1) misses
+    // the record by the integrator's period error (~1e-5 of the signal), hundreds of times
+    // the noise the fourth differences see (rounding); every value used to be withheld
+    let s = Scenario::table1();
+    let r = rotorid::simulate::simulate(&s, rotorid::simulate::Method::Newmark).unwrap();
+    let rec = Record::from_response(&r).unwrap();
+    let k = Knowledge::from_scenario(&s);
+    for method in [Method::algebraic(), Method::modulating(), Method::refine()] {
+        let id = identify(&rec, &k, &method).unwrap();
+        let name = format!("{:?}", method.name());
+        let a = id.adequacy.unwrap_or_else(|| panic!("{name}: not judged"));
+        assert!(a.model_adequate, "{name}: {a:?}");
+        for c in [a.x, a.z] {
+            assert_eq!(c.basis, AdequacyBasis::SmallResidual, "{name}: {c:?}");
+            assert!(
+                c.noise_ratio > NOISE_RATIO_MAX,
+                "{name}: the tests alone fail"
+            );
+            assert!(
+                (1e-7..SMALL_RESIDUAL_MAX).contains(&c.relative_residual),
+                "{name}: {c:?}"
+            );
+        }
+        let notes: Vec<_> = id
+            .diagnostics
+            .iter()
+            .filter(|d| matches!(d.finding, Finding::SmallResidual { .. }))
+            .collect();
+        assert_eq!(notes.len(), 2, "{name}: {:?}", id.diagnostics);
+        assert!(notes.iter().all(|d| d.severity == Severity::Note));
+        assert!(
+            notes[0].message.contains("cannot tell"),
+            "{}",
+            notes[0].message
+        );
+        assert!(!id
+            .diagnostics
+            .iter()
+            .any(|d| matches!(d.finding, Finding::ModelInadequate { .. })));
+        // the values, within the integrator's error of the truth
+        for p in &id.parameters {
+            let v = p
+                .value
+                .unwrap_or_else(|| panic!("{name}: {:?} withheld", p.parameter));
+            let e = (v - p.truth.unwrap()).abs() / p.truth.unwrap();
+            assert!(e < 1e-2, "{name}: {:?} off by {e:e}", p.parameter);
+        }
+    }
+    // the same record with a wrong model's share of 3e-4 of the signal is still rejected
+    let mut bad = r.clone();
+    let rms = (r.x.iter().map(|v| v * v).sum::<f64>() / r.x.len() as f64).sqrt();
+    for (i, x) in bad.x.iter_mut().enumerate() {
+        *x += 3e-4 * rms * std::f64::consts::SQRT_2 * (700.0 * i as f64 * 1e-4).sin();
+    }
+    let id = identify(&Record::from_response(&bad).unwrap(), &k, &Method::refine()).unwrap();
+    assert!(flagged(&id), "{:?}", id.adequacy);
 }
 
 #[test]
@@ -380,5 +479,6 @@ fn hundred_seed_algebraic_adequacy_rates() {
             )
         });
         println!("  {d:?}: (judged, flagged) at 40 dB and noise-free {rates:?}");
+        assert!(rates.iter().all(|r| r.1 >= 0.95), "{d:?}: {rates:?}");
     }
 }
