@@ -4,8 +4,8 @@
 //! included; `adequacy/CASE/METHOD` the verdict alone ([`adequacy_of`] from the
 //! identification's own estimate). The identification without the verdict costs the
 //! difference. Records of 1 s and 10 s at 10 kHz at 40 dB with per-sample speed columns,
-//! as a CSV gives them: the paper's rotor at 1200 rpm, its 600 rpm + 10 rad/s^2 run-up,
-//! and the wrong model of an x support on a foundation (1 s).
+//! as a CSV gives them: the paper's rotor at 1200 rpm, its 600 rpm + 10 rad/s^2 run-up
+//! (1 s and 10 s), and the wrong model of an x support on a foundation (1 s).
 //!
 //! Run: `cargo bench -p rotorid --bench adequacy`.
 
@@ -131,6 +131,11 @@ fn bench(c: &mut Criterion) {
         s
     };
     let ramp = Scenario::table1_ramp(600.0).expect("valid ramp");
+    let long_ramp = {
+        let mut s = ramp;
+        s.sampling = Sampling::new(1e-4, 10.0).expect("valid sampling");
+        s
+    };
     let sim = |s: &Scenario| simulate(s, SimMethod::Exact).expect("simulation");
     let cases = [
         ("table1_1s", table1, sim(&table1)),
@@ -141,6 +146,7 @@ fn bench(c: &mut Criterion) {
             defects::simulate_defective(defects::DEFECTS[1]),
         ),
         ("table1_10s", long, sim(&long)),
+        ("ramp600_10s", long_ramp, sim(&long_ramp)),
     ];
     let mut g = c.benchmark_group("adequacy");
     g.sample_size(10)

@@ -37,7 +37,8 @@ mod start;
 pub(crate) use adequacy::channel as channel_adequacy;
 pub use adequacy::{
     Adequacy, AdequacyBasis, ChannelAdequacy, Refit, ADEQUACY_P_MIN, LJUNG_BOX_LAGS,
-    NOISE_RATIO_MAX, REFIT_SAMPLES, REFIT_SAMPLES_PER_PERIOD, RESIDUAL_FLOOR, SMALL_RESIDUAL_MAX,
+    NOISE_RATIO_MAX, REFIT_MODEL_ERROR, REFIT_SAMPLES, REFIT_SAMPLES_PER_PERIOD, RESIDUAL_FLOOR,
+    SMALL_RESIDUAL_MAX,
 };
 pub use consistency::SPEED_FACTOR_TOLERANCE;
 pub use diagnostic::{Diagnostic, Direction, Directions, Finding, Severity};

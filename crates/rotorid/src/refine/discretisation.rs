@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::error::RefineError;
 use super::exact_step::ExactStep;
 use super::record::Experiment;
-use super::rk4_step::{substeps_for, Rk4Step};
+use super::rk4_step::{substeps_within, Rk4Step, FREQ_TOL};
 use super::speed_table::{max_speed, oscillator_table, rk4_table, ForcePoint};
 use super::sweep::{sweep, Sink};
 use super::unknowns::{Columns, Theta};
@@ -54,6 +54,18 @@ impl Discrete {
         discretisation: Discretisation,
         t: &Theta,
     ) -> Result<Self, RefineError> {
+        Self::within(exp, discretisation, t, FREQ_TOL)
+    }
+
+    /// [`Discrete::new`] with the automatic RK4 sub-step count bounding the relative
+    /// frequency error by `freq_tol` instead of `FREQ_TOL` (the adequacy verdict's fit:
+    /// its model error need only be small against the record's noise).
+    pub(crate) fn within(
+        exp: &Experiment,
+        discretisation: Discretisation,
+        t: &Theta,
+        freq_tol: f64,
+    ) -> Result<Self, RefineError> {
         let constant = exp.speed.constant();
         match (discretisation, constant) {
             (Discretisation::Auto | Discretisation::Exact, Some((omega, phi0))) => {
@@ -67,14 +79,14 @@ impl Discrete {
             (Discretisation::Exact, None) => {
                 Err(RefineError::ExactNeedsConstantSpeed(exp.speed.describe()))
             }
-            (Discretisation::Auto, None) => Ok(Self::rk4(exp, 0, t)),
-            (Discretisation::Rk4 { substeps }, _) => Ok(Self::rk4(exp, substeps, t)),
+            (Discretisation::Auto, None) => Ok(Self::rk4(exp, 0, t, freq_tol)),
+            (Discretisation::Rk4 { substeps }, _) => Ok(Self::rk4(exp, substeps, t, freq_tol)),
         }
     }
 
-    fn rk4(exp: &Experiment, substeps: usize, t: &Theta) -> Self {
+    fn rk4(exp: &Experiment, substeps: usize, t: &Theta, freq_tol: f64) -> Self {
         let substeps = if substeps == 0 {
-            substeps_for(t, max_speed(exp), exp.dt)
+            substeps_within(t, max_speed(exp), exp.dt, freq_tol)
         } else {
             substeps
         };

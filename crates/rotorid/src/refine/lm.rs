@@ -374,7 +374,12 @@ fn continuation(
     if options.unknowns.cz {
         theta.cz = theta.cz.max(0.0);
     }
-    let disc = Discrete::new(&record.experiment(), options.discretisation, &theta)?;
+    let disc = Discrete::within(
+        &record.experiment(),
+        options.discretisation,
+        &theta,
+        how.rk4_freq_tol,
+    )?;
     let disc = if how.balanced { disc.balanced() } else { disc };
 
     let dt = record.dt;
@@ -447,6 +452,9 @@ pub(crate) struct Continuation {
     pub window_tolerance: f64,
     /// Exact steps on the balanced state (`Discrete::balanced`).
     pub balanced: bool,
+    /// Bound on the automatic RK4 sub-steps' relative frequency error
+    /// (`Discrete::within`; refine's own: `FREQ_TOL`, 1e-9).
+    pub rk4_freq_tol: f64,
 }
 
 impl Default for Continuation {
@@ -455,6 +463,7 @@ impl Default for Continuation {
             stride: 1,
             window_tolerance: WINDOW_TOLERANCE,
             balanced: false,
+            rk4_freq_tol: super::rk4_step::FREQ_TOL,
         }
     }
 }

@@ -83,4 +83,5 @@ pub use result::{
     Bound, Crb, FittedValue, Refined, RobustCovariance, Warning, ALPHA_STD_LIMIT, CONDITION_LIMIT,
     STD_ERROR_BASIS,
 };
+pub(crate) use rk4_step::FREQ_TOL;
 pub use unknowns::Unknowns;

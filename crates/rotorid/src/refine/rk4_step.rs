@@ -25,8 +25,8 @@
 //! Error: for an oscillation at frequency w_n the RK4 step of length h has the relative
 //! frequency error (w_n h)^4 / 120 and the amplitude decay (w_n h)^6 / 144 per step
 //! (Hairer, Norsett, Wanner, *Solving ODEs I*, sec. II.2 / stability function
-//! R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24). `substeps_for` picks the number of sub-steps
-//! per sample that keeps the frequency error below [`FREQ_TOL`].
+//! R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24). `substeps_within` picks the number of sub-steps
+//! per sample that keeps the frequency error below [`FREQ_TOL`] (or a looser bound).
 
 use super::speed_table::ForcePoint;
 use super::sweep::Stepper;
@@ -36,16 +36,16 @@ use super::unknowns::{Columns, Kind, Theta, MAXP};
 /// relative Cramer-Rao bound ~4e-5 of m at 40 dB, and below the 1e-7 modelling budget).
 pub(crate) const FREQ_TOL: f64 = 1e-9;
 
-/// Sub-steps per sample interval `dt` \[s\] so that (w_ref dt / n)^4 / 120 <= FREQ_TOL,
-/// w_ref = max(sqrt(k/m) + |a| w_max / (2m), w_max) (the forward whirl frequency bound
-/// and the forcing frequency) \[rad/s\], k = ||K||_inf = max(|kx| + |kxz|, |kzx| + |kz|)
-/// (max(kx, kz) for a Jeffcott rotor).
-pub(crate) fn substeps_for(t: &Theta, w_max: f64, dt: f64) -> usize {
+/// Sub-steps per sample interval `dt` \[s\] so that (w_ref dt / n)^4 / 120 <= `freq_tol`
+/// (refine's own: [`FREQ_TOL`]), w_ref = max(sqrt(k/m) + |a| w_max / (2m), w_max) (the
+/// forward whirl frequency bound and the forcing frequency) \[rad/s\], k = ||K||_inf =
+/// max(|kx| + |kxz|, |kzx| + |kz|) (max(kx, kz) for a Jeffcott rotor).
+pub(crate) fn substeps_within(t: &Theta, w_max: f64, dt: f64, freq_tol: f64) -> usize {
     // ||K||_inf bounds the stiffness matrix's eigenvalues (max(kx, kz) without coupling)
     let k = (t.kx.abs() + t.kxz.abs()).max(t.kzx.abs() + t.kz.abs());
     let wn = (k / t.m).sqrt() + t.a.abs() * w_max / (2.0 * t.m);
     let w_ref = wn.max(w_max);
-    let h_max = (120.0 * FREQ_TOL).powf(0.25) / w_ref;
+    let h_max = (120.0 * freq_tol).powf(0.25) / w_ref;
     let n = (dt / h_max).ceil();
     if n.is_finite() {
         (n as usize).clamp(1, 10_000)
