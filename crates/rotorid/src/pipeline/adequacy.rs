@@ -135,7 +135,8 @@ pub struct Adequacy {
     pub refit: Option<Refit>,
 }
 
-/// The refit the modulating and algebraic methods are judged by ([`of_model`]).
+/// The refit the modulating and algebraic methods are judged by
+/// ([`adequacy_of`](super::adequacy_of)).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Refit {
     /// Every `stride`-th sample of the record was fitted and tested.
