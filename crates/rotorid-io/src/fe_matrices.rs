@@ -1,4 +1,4 @@
-//! The matrices file of a finite-element rotor (issue 27; docs/formats.md): an NPZ archive,
+//! The matrices file of a finite-element rotor (docs/formats.md): an NPZ archive,
 //! as `numpy.savez` or `numpy.savez_compressed` writes it, of
 //!
 //! | member | dtype | shape | holds |

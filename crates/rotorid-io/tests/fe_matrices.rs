@@ -1,4 +1,4 @@
-//! The finite-element matrices file (issue 27) against numpy: the files numpy.savez and
+//! The finite-element matrices file against numpy: the files numpy.savez and
 //! savez_compressed wrote (fixtures/fe/make.py: C and Fortran order, both byte orders,
 //! `dofs` as unicode and as bytes) read entry for entry, numpy's faults named, and the
 //! writer's members byte for byte what numpy.savez wrote for the same arrays.

@@ -1,4 +1,4 @@
-//! Finite-element rotors (issue 27) as Python loads them: the scenario TOML with `model =
+//! Finite-element rotors as Python loads them: the scenario TOML with `model =
 //! "finite_element"` joined with its matrices file (NPZ, relative to the scenario), every
 //! check the library's and `rotorid_io`'s, as the `rotorid` command makes them
 //! (crates/rotorid-cli/src/io/finite_element.rs).

@@ -6,8 +6,8 @@
 //!
 //! The cross-coupled model (docs/method.md section 5.6): m and its eight bearing
 //! coefficients with the initial state, on its test rotor at 1200 rpm and on the same
-//! ramp, from a start 2-20 % off with zero cross terms (the issue asks for at most 3x the
-//! Jeffcott fit's time).
+//! ramp, from a start 2-20 % off with zero cross terms (target: at most 3x the Jeffcott
+//! fit's time).
 //!
 //! Run: `cargo bench -p rotorid --bench refine`
 

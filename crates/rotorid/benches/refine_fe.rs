@@ -1,8 +1,8 @@
-//! Speed of the finite-element identification (issue 27: "1 s at 10 kHz of four probes
-//! identified in <= 5 s on one core"): the ROSS two-disk rotor (44 DOF), its response at
+//! Speed of the finite-element identification (target: 1 s at 10 kHz of four probes
+//! identified in at most 5 s on one core): the ROSS two-disk rotor (44 DOF), its response at
 //! both bearings (x, y) simulated with the full model, 40 dB, the fit started from the
 //! engineering guess of the tests (bearing coefficients 30-70 % off, unbalance angles 40
-//! deg off), the issue's default unknowns (8 direct bearing coefficients, 2 unbalances),
+//! deg off), the default unknowns (8 direct bearing coefficients, 2 unbalances),
 //! reduced to 6 modes + static shapes (the default). Each iteration is a whole `refine_fe` (including
 //! the reduction's bias check, one full-model simulation). One thread.
 //!

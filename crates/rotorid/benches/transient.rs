@@ -25,7 +25,7 @@ use rotorid::transient::order::track_signals;
 use rotorid::transient::{track, track_record, OrderSettings};
 use rotorid::{Sampling, Scenario, SpeedProfile};
 
-/// The sampling rate of the record \[Hz\].
+/// The sampling rate of the benchmark's record \[Hz\].
 const RATE_HZ: f64 = 25_600.0;
 
 /// The run-up's raw record and its acquisition, simulated outside the timing.

@@ -3,7 +3,7 @@
 //! from identified (or stated) rotor parameters to the numbers an engineer decides on,
 //! with the uncertainty of the identification carried through (`rotorid::analysis`).
 //!
-//! A finite-element rotor (issue 27): `rotorid analyze --scenario fe.toml --out DIR` or
+//! A finite-element rotor: `rotorid analyze --scenario fe.toml --out DIR` or
 //! `rotorid analyze SUMMARY.json --scenario fe.toml --out DIR [--modes N]` (a summary with
 //! `model` = `"finite_element"` needs its scenario for the matrices); its `analysis.json`
 //! keeps the layout below where it applies, with `model` = `"finite_element"`, `rotor` by

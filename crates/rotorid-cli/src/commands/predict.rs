@@ -1,5 +1,5 @@
-//! `rotorid predict SUMMARY.json --scenario S.toml --dofs 3.x,3.y --out pred.csv` (issue 27
-//! item 4): the identified finite-element rotor's response at degrees of freedom no probe
+//! `rotorid predict SUMMARY.json --scenario S.toml --dofs 3.x,3.y --out pred.csv`: the
+//! identified finite-element rotor's response at degrees of freedom no probe
 //! watches, with a standard-deviation band from the identification's covariance.
 //!
 //! The rotor is the scenario's with the summary's identified values

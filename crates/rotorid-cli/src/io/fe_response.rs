@@ -1,4 +1,4 @@
-//! The response file of a finite-element rotor (issue 27; docs/formats.md, "The response
+//! The response file of a finite-element rotor (docs/formats.md, "The response
 //! file of a finite-element rotor"): one row per sample, the columns
 //!
 //! ```text

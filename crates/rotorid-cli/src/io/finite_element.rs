@@ -1,4 +1,4 @@
-//! Finite-element rotors (issue 27): the scenario's `[rotor]` with `model =
+//! Finite-element rotors: the scenario's `[rotor]` with `model =
 //! "finite_element"` ([`rotorid::scenario_file::FiniteElementSpec`]) joined with its
 //! matrices file (`rotorid_io::fe_matrices`), whose path is relative to the scenario file.
 //! Every message names the file at fault: the scenario (file and line), or the matrices

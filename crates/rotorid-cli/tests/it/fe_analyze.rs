@@ -1,4 +1,4 @@
-//! `rotorid analyze` of a finite-element rotor (issue 27 item 6), end to end: the one-node
+//! `rotorid analyze` of a finite-element rotor, end to end: the one-node
 //! rotor of `predict.rs` analysed from a hand-written finite-element summary on its
 //! scenario equals `rotorid analyze` of the same rotor written as a cross-coupled 2-DOF
 //! summary (x = x, y = -z: kxz = -kxy, kzx = -kyx, alpha + 90 deg; docs/finite_element.md

@@ -1,4 +1,4 @@
-//! The data of a finite-element rotor (issue 27 item 1): raw acquisitions with two probes
+//! The data of a finite-element rotor: raw acquisitions with two probes
 //! per measured node (`[[acquisition.probe]] node = N`), simulated by `rotorid simulate
 //! --raw` and conditioned back by `rotorid condition` (docs/acquisition.md section 11).
 //! Checked against the simulated response itself (exactly, without noise; within the

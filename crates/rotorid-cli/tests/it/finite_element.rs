@@ -1,4 +1,4 @@
-//! `rotorid simulate` of a finite-element scenario (issue 27): the matrices file beside
+//! `rotorid simulate` of a finite-element scenario: the matrices file beside
 //! the scenario, the response at every degree of freedom under `<node>.<dof>` columns,
 //! checked end to end against an independent path: a one-node rotor is the cross-coupled
 //! 2-DOF model under x = x, y = -z (docs/finite_element.md section 2), which `rotorid

@@ -46,7 +46,7 @@ fn identifies_like(dir: &Path, rec: &str, columns: Option<&str>, reference: &[(V
     }
 }
 
-/// The acceptance test: one record (crates/rotorid-io/fixtures/ident.csv, made by
+/// The formats' acceptance test: one record (crates/rotorid-io/fixtures/ident.csv, made by
 /// `rotorid simulate`) written by each ecosystem's reference tool (fixtures/make.py:
 /// numpy, pyarrow, scipy.io.savemat, h5py as MATLAB -v7.3, npTDMS, pyuff 58b) identifies
 /// bit for bit like the CSV with every method.

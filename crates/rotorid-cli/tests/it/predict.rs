@@ -1,4 +1,4 @@
-//! `rotorid predict SUMMARY.json --scenario fe.toml --dofs ... --out ...` (issue 27 item 4)
+//! `rotorid predict SUMMARY.json --scenario fe.toml --dofs ... --out ...`
 //! on a one-node finite-element rotor with a hand-written summary (the contract of the
 //! finite-element SUMMARY.json): the prediction is the identified rotor simulated by
 //! `rotorid simulate`; its standard deviation is checked against the closed-form

@@ -1,4 +1,4 @@
-//! Raw acquisitions of a finite-element rotor (issue 27; docs/acquisition.md section 11):
+//! Raw acquisitions of a finite-element rotor (docs/acquisition.md section 11):
 //! two proximity probes at each measured node (`[[acquisition.probe]] node = N`) and one
 //! keyphasor, to the response at the measured nodes' `x`, `y`, and back.
 //!

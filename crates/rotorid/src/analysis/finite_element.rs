@@ -1,4 +1,4 @@
-//! Analysis of a finite-element rotor (issue 27 item 6; docs/analysis.md, "Finite-element
+//! Analysis of a finite-element rotor (docs/analysis.md, "Finite-element
 //! rotors"): Campbell diagram, critical speeds, stability and the unbalance per plane, with
 //! standard deviations from a covariance over [`FeParameter`]s (e.g. that of an
 //! identification).

@@ -1,4 +1,4 @@
-//! `[rotor]` of a finite-element rotor (issue 27; docs/formats.md):
+//! `[rotor]` of a finite-element rotor (docs/formats.md):
 //!
 //! ```toml
 //! [rotor]
@@ -337,7 +337,7 @@ mod tests {
     use super::*;
     use crate::model::finite_element::Dof;
 
-    /// The contract's example (issue 27), with a second bearing.
+    /// The example of docs/formats.md, with a second bearing.
     const FE: &str = r#"[rotor]
 model = "finite_element"
 matrices = "rotor.npz"            # relative to this file

@@ -38,7 +38,7 @@
 //! one with zero cross terms, and a cross-coupled rotor's direct coefficients are the
 //! Jeffcott model's cx, kx, cz, kz.
 //!
-//! `rotor.model = "finite_element"` (issue 27) is a rotor whose shaft and disks come as
+//! `rotor.model = "finite_element"` is a rotor whose shaft and disks come as
 //! matrices: `[rotor]` then holds `matrices` (the path of the matrices file, relative to
 //! the scenario file), `[[rotor.bearing]]` and `[[rotor.unbalance]]` tables
 //! ([`FiniteElementSpec`], whose module doc lists the keys). The caller reads the matrices

@@ -20,7 +20,7 @@
 //! Every integrator produces sample i at t_i = i * dt exactly (computed so, never by
 //! accumulating dt), starting from t_0 = 0 with the scenario's initial state.
 //!
-//! Finite-element rotors (issue 27) have their own integrators and response table in
+//! Finite-element rotors have their own integrators and response table in
 //! [`finite_element`] (the Jeffcott and cross-coupled path above is unchanged).
 //!
 //! Also here: [`add_noise`] (white Gaussian measurement noise at a given SNR, reproducible

@@ -263,7 +263,7 @@ fn iterated(seed: u64, first: Option<&ModelGuess>) -> (Identification, usize) {
 fn the_iteration_reaches_what_the_true_rotor_gives_where_two_passes_did_not() {
     // The run-up without a first guess: the iteration ends where conditioning with the
     // true rotor ends, to a fraction of a standard error; two passes (as before) stop
-    // several standard errors short (what the issue measured: m, kx, kz biased by about
+    // several standard errors short (measured: m, kx, kz biased by about
     // five standard errors, the same sign on every seed). The study below measures the
     // errors against perfect channels and the bound.
     let (from_nothing, passes) = iterated(1, None);

@@ -234,7 +234,7 @@ fn analysis_threshold_and_log_dec_std_agree_with_monte_carlo() {
     );
 }
 
-/// The check on identified data: refine's fit of the cross-coupled rotor (40 dB,
+/// The check on identified data: refine's fit of the cross-coupled rotor (40 dB,
 /// constant speed from rest, several seeds) and its covariance give the least damped
 /// mode's logarithmic decrement at the operating speed within 3 of its standard deviations
 /// of the true rotor's.

@@ -1,5 +1,5 @@
 //! The cross-coupled algebraic identifier (docs/method.md section 3.10) on exact data from
-//! the independent reference of `cross_common`: the criterion (every value within
+//! the independent reference of `cross_common`: the acceptance criterion (every value within
 //! 1e-6 relative at 0.1 s), the Jeffcott rotor through the new code against the 3x3
 //! identifier, the conditioning threshold, and the constant-speed and batch forms.
 
@@ -72,7 +72,7 @@ fn table(label: &str, v: &[f64; 10]) {
 
 #[test]
 fn every_value_within_1e_6_relative_at_100_ms() {
-    // The criterion, on three rotors (cross-coupled, anisotropic, cross terms not
+    // The acceptance criterion, on three rotors (cross-coupled, anisotropic, cross terms not
     // antisymmetric), three speed profiles, from rest and from a non-zero state. The
     // error is am5's quadrature error (it falls 32x when dt is halved), ~1e-5 N s/m in the
     // damping terms: 1e-6 of a cross damping of ~30 N s/m. So a cross term may also pass

@@ -2,7 +2,7 @@
 //! (`--method algebraic|modulating --model cross_coupled`): the same estimates as the
 //! identifiers called directly (which tests/it/cross_algebraic.rs and cross_modulating.rs
 //! check against an independent reference), the values named by the model's parameters,
-//! the accuracy at 0.1 s on clean data, and at 40 dB values within their standard
+//! the required accuracy at 0.1 s on clean data, and at 40 dB values within their standard
 //! errors, the Cramer-Rao bound of the cross-coupled model and an adequacy verdict.
 
 use rotorid::identify::algebraic::{identify_cross_response, AlgebraicConfig};
@@ -62,7 +62,7 @@ fn algebraic_is_the_cross_identifier_and_meets_1e_6_at_100_ms() {
         assert_eq!(bits(s.values()), bits(&d.values()));
         assert_eq!(s.rcond, [d.x.rcond, d.z.rcond]);
     }
-    // the criterion at 0.1 s: every value within 1e-6 of its truth, or (a cross
+    // the acceptance criterion at 0.1 s: every value within 1e-6 of its truth, or (a cross
     // damping of 20 N s/m, where am5's quadrature error is ~2e-5 N s/m) within 1e-7 of its
     // row's direct coefficient
     let truth = tm.truth();

@@ -1,4 +1,4 @@
-//! Simulation of finite-element rotors against independent references (issue 27 item 2):
+//! Simulation of finite-element rotors against independent references:
 //! - the closed-form steady state against ROSS's own unbalance response;
 //! - the exact constant-speed discretisation (closed-form particular + expm) against the
 //!   closed form after the transient and against the Magnus integrator (augmented
@@ -251,7 +251,7 @@ fn bad_inputs_are_refused_naming_what_is_wrong() {
 }
 
 #[test]
-fn response_table_names_its_columns_as_the_issue_does() {
+fn response_table_names_its_columns_as_docs_formats_does() {
     let rotor = ross_rotor();
     let sys = RitzBasis::new(&rotor, 4).unwrap().system(&rotor).unwrap();
     let speed = SpeedProfile::Constant {

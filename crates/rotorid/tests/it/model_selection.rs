@@ -2,7 +2,7 @@
 //! (constant speed from rest and a run-up, 40 dB) a Jeffcott fit is flagged inadequate,
 //! says that cross-coupled bearings explain the data, and auto takes the cross-coupled
 //! model; on records of the paper's Jeffcott rotor auto takes the Jeffcott model. The
-//! #[ignore]d study runs 100 seeds per case and prints the rates (the issue asks >= 95 %).
+//! #[ignore]d study runs 100 seeds per case and prints the rates (required: >= 95 %).
 
 use rotorid::parameter::ModelKind;
 use rotorid::pipeline::{

@@ -1,4 +1,4 @@
-//! `rotorid analyze` of a finite-element rotor (issue 27 item 6): `rotorid analyze --scenario
+//! `rotorid analyze` of a finite-element rotor: `rotorid analyze --scenario
 //! fe.toml --out DIR` (the scenario's values, no uncertainty) or `rotorid analyze
 //! SUMMARY.json --scenario fe.toml --out DIR` (a finite-element identification's values on
 //! its scenario's matrices, with standard deviations from its covariance;

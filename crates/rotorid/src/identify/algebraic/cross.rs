@@ -1,8 +1,8 @@
-//! The algebraic identifier of the cross-coupled rotor (issue 26; docs/method.md section
+//! The algebraic identifier of the cross-coupled rotor (docs/method.md section
 //! 3.10): per direction m and the four bearing coefficients of that row, streaming, one
 //! estimate per sample, O(1) work, no allocation.
 //!
-//! The model (docs/method.md section 1, with the cross-coupled bearing of the lead's note):
+//! The model (docs/method.md section 1):
 //!
 //! ```text
 //! x:  m x'' + cxx x' + cxz z' - a w z' + kxx x + kxz z - a w' z = m_u d fx

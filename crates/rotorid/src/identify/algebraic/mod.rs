@@ -16,7 +16,7 @@
 //! - [`ConvergenceTracker`]: final values and identification times in bounded memory.
 //! - [`identify_batch`], [`identify_response`]: whole records.
 //!
-//! The cross-coupled rotor (issue 26; docs/method.md section 3.10): per row m and that
+//! The cross-coupled rotor (docs/method.md section 3.10): per row m and that
 //! row's four bearing coefficients, five unknowns, from the same scalar equation and its
 //! iterated integrals I1..I4 (a 5x5 system of I0..I6 of the same signals):
 //!

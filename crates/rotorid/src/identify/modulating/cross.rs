@@ -1,9 +1,9 @@
-//! The modulating-function identifier of the cross-coupled rotor (issue 26;
-//! docs/method.md section 4.8): per row m and the four bearing coefficients of that row,
+//! The modulating-function identifier of the cross-coupled rotor
+//! (docs/method.md section 4.8): per row m and the four bearing coefficients of that row,
 //! by least squares over sliding windows, with the noise bias of both channels removed and
 //! sandwich standard errors.
 //!
-//! Multiplying the cross-coupled rows (docs/method.md section 1, the lead's model note) by
+//! Multiplying the cross-coupled rows (docs/method.md section 1) by
 //! a test function psi and integrating over a window [t_j, t_j + L] moves every
 //! derivative onto psi, as for the Jeffcott rows (module docs of [`super`]); with the
 //! window sums S[g] = sum over the window's samples of g and u-derivatives of psi:

@@ -48,7 +48,7 @@
 //!   memory independent of the record length).
 //! - [`identify_modulating`], [`identify_modulating_response`]: whole records.
 //!
-//! The cross-coupled rotor (issue 26; docs/method.md section 4.8): per row m and the four
+//! The cross-coupled rotor (docs/method.md section 4.8): per row m and the four
 //! bearing coefficients of that row, from the same window sums, with the noise bias of both
 //! channels (in the regressors and in the right-hand side) compensated and sandwich
 //! standard errors:

@@ -1,4 +1,4 @@
-//! Finite-element rotors (issue 27): the shaft and disks come as matrices, the bearings and
+//! Finite-element rotors: the shaft and disks come as matrices, the bearings and
 //! the unbalances as parameters. The equation of motion, in the frame of the matrices file
 //! (nodes along +z, the shaft turning from +x towards +y; docs/finite_element.md):
 //!

@@ -11,7 +11,7 @@
 //!
 //! where b_x, b_y are the location vectors of a node's x and y (the unit vectors e_x, e_y
 //! in the full model, their images T^T e_x, T^T e_y in a reduced one). Written out, the
-//! force at an unbalance's node is the issue's `mud (w^2 cos th + w' sin th, w^2 sin th -
+//! force at an unbalance's node is `mud (w^2 cos th + w' sin th, w^2 sin th -
 //! w' cos th)`, th = phi + alpha, in (x, y): the real part of (w^2 - i w') e^{i th} (1, -i).
 //! P is ROSS's complex unbalance force per w^2 (`Rotor._unbalance_force`: `mud e^{i
 //! alpha}` at x, `-i mud e^{i alpha}` at y).
@@ -468,7 +468,7 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn force_is_the_issues_formula_at_the_unbalance_node() {
+    fn force_is_the_documented_formula_at_the_unbalance_node() {
         let r = small_rotor();
         let s = FeSystem::full(&r);
         let u = r.unbalances[0];

@@ -1,6 +1,6 @@
 //! Maximum-likelihood (output-error) identification of the bearings and unbalances of a
-//! finite-element rotor from the response at its measured degrees of freedom (issue 27,
-//! docs/finite_element.md section 6).
+//! finite-element rotor from the response at its measured degrees of freedom
+//! (docs/finite_element.md section 6).
 //!
 //! **Model.** `M q'' + (C + C_b + w G) q' + (K + K_b + w' Ka) q = F` (see
 //! [`crate::model::finite_element`]), reduced to a Ritz basis T (the lowest `modes` modes
@@ -116,7 +116,7 @@ pub struct FeRefineOptions {
 }
 
 impl FeRefineOptions {
-    /// The issue's defaults for `rotor`: the direct coefficients of every bearing and every
+    /// The default unknowns for `rotor`: the direct coefficients of every bearing and every
     /// unbalance unknown, initial state estimated, 6 modes (at most the degrees of freedom).
     pub fn new(rotor: &FiniteElementRotor) -> Self {
         Self {

@@ -1,4 +1,4 @@
-//! Time-domain simulation of finite-element rotors (issue 27; docs/finite_element.md
+//! Time-domain simulation of finite-element rotors (docs/finite_element.md
 //! section 3), in full or reduced coordinates ([`FeSystem`]):
 //!
 //! ```text
@@ -167,7 +167,7 @@ impl FeResponse {
     }
 
     /// The table's column names: `t`, one `<node>.<dof>` per output, `phi`, `phi_dot`,
-    /// `phi_ddot` (the order of the issue's response files).
+    /// `phi_ddot` (the order of the response files, docs/formats.md).
     pub fn header(&self) -> Vec<String> {
         let mut h = vec!["t".to_owned()];
         h.extend(self.dofs.iter().map(|d| d.to_string()));

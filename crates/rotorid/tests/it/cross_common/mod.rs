@@ -1,4 +1,4 @@
-//! An independent reference for the cross-coupled 2-DOF rotor (issue 26), written here from
+//! An independent reference for the cross-coupled 2-DOF rotor, written here from
 //! the model note rather than taken from the library's simulator:
 //!
 //! ```text

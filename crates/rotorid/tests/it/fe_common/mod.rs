@@ -119,7 +119,7 @@ pub fn rms_rel(a: &FeResponse, b: &FeResponse) -> f64 {
     (e / s).sqrt()
 }
 
-/// The probes of the issue: x and y at both bearings (nodes 0 and 10).
+/// The probes of the tests: x and y at both bearings (nodes 0 and 10).
 pub fn probes() -> Vec<Dof> {
     ["0.x", "0.y", "10.x", "10.y"]
         .iter()
