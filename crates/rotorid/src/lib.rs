@@ -24,6 +24,7 @@ pub mod model;
 pub mod parameter;
 pub mod pipeline;
 pub mod refine;
+pub mod residual;
 #[cfg(feature = "toml")]
 pub mod scenario_file;
 pub mod simulate;
@@ -35,3 +36,9 @@ pub use model::{
     InitialState, Rotor, RotorParams, Sampling, Scenario, SpeedProfile, SpeedState, Unbalance,
 };
 pub use parameter::Parameter;
+
+/// Version of the serialised identification summaries (the pipeline's and the
+/// finite-element fit's); incremented on incompatible changes (3: `model`, the
+/// cross-coupled model's parameter names, `rotor` keyed by the model's parameters,
+/// `model_selection`).
+pub const IDENTIFICATION_SCHEMA: u32 = 3;

@@ -17,10 +17,7 @@ use super::method::MethodName;
 use super::record::SpeedSource;
 use super::session::SampleEstimate;
 
-/// Version of the serialised form; incremented on incompatible changes (3: `model`, the
-/// cross-coupled model's parameter names, `rotor` keyed by the model's parameters,
-/// `model_selection`).
-pub const IDENTIFICATION_SCHEMA: u32 = 3;
+pub use crate::IDENTIFICATION_SCHEMA;
 
 /// The record as the pipeline saw it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

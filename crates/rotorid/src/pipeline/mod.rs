@@ -34,7 +34,6 @@ mod refine_run;
 mod session;
 mod start;
 
-pub(crate) use adequacy::channel as channel_adequacy;
 pub use adequacy::{
     Adequacy, AdequacyBasis, ChannelAdequacy, Refit, ADEQUACY_P_MIN, LJUNG_BOX_LAGS,
     NOISE_RATIO_MAX, REFIT_MODEL_ERROR, REFIT_SAMPLES, REFIT_SAMPLES_PER_PERIOD, RESIDUAL_FLOOR,

@@ -49,7 +49,7 @@ use super::order::C64;
 use super::synchronous::{synchronous, Sweep};
 use crate::model::description::{ModalDescription, Mode};
 use crate::model::{rad_per_s_to_rpm, OutOfRange};
-use crate::pipeline::adequacy::{gamma_q, ADEQUACY_P_MIN, LJUNG_BOX_LAGS, NOISE_RATIO_MAX};
+use crate::residual::{ljung_box, ADEQUACY_P_MIN, NOISE_RATIO_MAX};
 
 /// Settings of [`fit_modes`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -434,31 +434,6 @@ fn levenberg_marquardt(
     })
 }
 
-/// The Ljung-Box p-value of `r` over [`LJUNG_BOX_LAGS`] lags (1 for short series).
-fn ljung_box(r: &[f64]) -> f64 {
-    let n = r.len();
-    let lags = LJUNG_BOX_LAGS.min(n / 4);
-    if lags == 0 {
-        return 1.0;
-    }
-    let mean = r.iter().sum::<f64>() / n as f64;
-    let c: Vec<f64> = r.iter().map(|v| v - mean).collect();
-    let c0: f64 = c.iter().map(|v| v * v).sum();
-    if c0 <= 0.0 {
-        return 1.0;
-    }
-    let nf = n as f64;
-    let q = (1..=lags)
-        .map(|k| {
-            let rho = c[k..].iter().zip(&c).map(|(a, b)| a * b).sum::<f64>() / c0;
-            rho * rho / (nf - k as f64)
-        })
-        .sum::<f64>()
-        * nf
-        * (nf + 2.0);
-    gamma_q(lags as f64 / 2.0, q / 2.0)
-}
-
 /// The modes of the sensors' 1X vectors along `sweep` (module doc), started from
 /// `guesses` (most significant first, as [`guesses`] gives them).
 ///
@@ -639,7 +614,7 @@ pub fn fit_modes(
         .chunks(per_sensor)
         .map(|r| {
             let (re, im) = r.split_at(points.len());
-            ljung_box(re).min(ljung_box(im))
+            ljung_box(re).p.min(ljung_box(im).p)
         })
         .collect();
     let noise_ratio = if known { s2.sqrt() } else { f64::NAN };

@@ -6,8 +6,8 @@ use serde::Serialize;
 use super::evaluate::{normal_equations, Evaluation};
 use super::{full_initial, FeInitial, FeProblem, FeRefineError, FeRefineOptions, Fit};
 use crate::model::finite_element::{Dof, FeParameter, FiniteElementRotor};
-use crate::pipeline::ChannelAdequacy;
 use crate::refine::CONDITION_LIMIT;
+use crate::residual::ChannelAdequacy;
 use crate::simulate::finite_element::FeInitialState;
 
 /// One estimated parameter of a finite-element rotor.
@@ -264,7 +264,7 @@ pub(crate) fn finish(
         .outputs()
         .iter()
         .enumerate()
-        .map(|(c, d)| (*d, crate::pipeline::channel_adequacy(y[c], &eval.y[c], dt)))
+        .map(|(c, d)| (*d, crate::residual::channel(y[c], &eval.y[c], dt)))
         .collect();
     for (d, a) in &adequacy {
         if !a.adequate {

@@ -8,7 +8,8 @@ use serde::Serialize;
 
 use super::{FeInitial, FeOffset, FeReduction, FeRefined, FeWarning};
 use crate::model::finite_element::{Bearing, FeUnbalance};
-use crate::pipeline::{ChannelAdequacy, IDENTIFICATION_SCHEMA};
+use crate::residual::ChannelAdequacy;
+use crate::IDENTIFICATION_SCHEMA;
 
 /// The summary (module doc). Non-finite numbers are written as null.
 #[derive(Debug, Clone, Serialize)]
