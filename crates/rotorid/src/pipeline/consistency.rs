@@ -103,21 +103,3 @@ impl SpeedConsistency {
         out
     }
 }
-
-/// The unit slip a factor suggests (`column` = factor x reference).
-pub(crate) fn hint(factor: f64) -> &'static str {
-    let near = |v: f64| (factor / v - 1.0).abs() < 0.01;
-    if near(60.0 / std::f64::consts::TAU) {
-        ": rpm given as rad/s (or rpm/s as rad/s^2)?"
-    } else if near(std::f64::consts::TAU / 60.0) {
-        ": the angle in rev or the speed in rad/s where rpm was meant?"
-    } else if near(1.0 / std::f64::consts::TAU) {
-        ": Hz given as rad/s?"
-    } else if near(180.0 / std::f64::consts::PI) {
-        ": degrees given as radians?"
-    } else if near(std::f64::consts::PI / 180.0) {
-        ": phi in degrees?"
-    } else {
-        ""
-    }
-}

@@ -373,7 +373,7 @@ fn message(f: &Finding) -> String {
              an unmodelled mode or a wrong speed signal? The standard errors assume a correct \
              model, so every value is withheld (the raw numbers stay in `estimate`)",
             direction.name(),
-            super::adequacy::LJUNG_BOX_LAGS,
+            crate::residual::LJUNG_BOX_LAGS,
             dominant_frequency_hz.map_or(String::new(), |f| format!(
                 "; dominant residual frequency {f:.1} Hz"
             ))
@@ -438,17 +438,17 @@ fn message(f: &Finding) -> String {
         } => format!(
             "{column} is {factor:.4}x {reference}{}: the speed columns must be phi [rad], \
              phi_dot [rad/s], phi_ddot [rad/s^2]; every value is withheld",
-            super::consistency::hint(*factor)
+            super::limits::unit_slip_hint(*factor)
         ),
         Finding::SpeedDiffersFromProfile { factor } => format!(
             "the data's phi_dot is {factor:.4}x the speed of the scenario's [speed] profile{}: \
              the identification used the data's columns; check the units of phi_dot or the \
              scenario",
-            super::consistency::hint(*factor)
+            super::limits::unit_slip_hint(*factor)
         ),
         Finding::ImplausibleDisplacement { direction, peak_m } => {
             let d = direction.name();
-            if *peak_m > super::plausibility::DISPLACEMENT_MAX_M {
+            if *peak_m > super::limits::DISPLACEMENT_MAX_M {
                 format!(
                     "{d} reaches {peak_m:.3e} m, more than a proximity probe measures (about \
                      2 mm): values in um or mm read as metres? Give the unit in the header \

@@ -27,6 +27,7 @@ mod error;
 mod grid;
 mod identification;
 mod knowledge;
+mod limits;
 mod method;
 mod plausibility;
 mod record;
@@ -52,11 +53,11 @@ pub use identification::{
     RefineDetail, RotorSummary, Start, StartSource, StateResult, IDENTIFICATION_SCHEMA,
 };
 pub use knowledge::{Knowledge, RotorValues, Truth};
+pub use limits::{DISPLACEMENT_MAX_M, DISPLACEMENT_MIN_M, NOISE_TO_SIGNAL_MAX};
 pub use method::{
     AlgebraicSettings, Method, MethodName, ModelChoice, ModulatingSettings, RefineSettings,
     StartPolicy,
 };
-pub use plausibility::{DISPLACEMENT_MAX_M, DISPLACEMENT_MIN_M, NOISE_TO_SIGNAL_MAX};
 pub use record::{rebased, Record, Speed, SpeedSource, CONSTANT_PHI_TOLERANCE};
 pub use refine_run::REFINE_MIN_SAMPLES;
 pub use session::{

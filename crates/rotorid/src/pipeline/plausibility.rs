@@ -14,13 +14,7 @@
 use crate::identify::modulating::noise_estimate::DifferenceNoise;
 
 use super::diagnostic::{Diagnostic, Direction, Finding};
-
-/// Largest plausible peak displacement of a probe channel \[m\].
-pub const DISPLACEMENT_MAX_M: f64 = 0.01;
-/// Smallest plausible peak displacement of a probe channel \[m\].
-pub const DISPLACEMENT_MIN_M: f64 = 1e-9;
-/// Largest plausible noise level over the channel's RMS.
-pub const NOISE_TO_SIGNAL_MAX: f64 = 0.3;
+use super::limits::{DISPLACEMENT_MAX_M, DISPLACEMENT_MIN_M, NOISE_TO_SIGNAL_MAX};
 
 /// Running magnitudes of x and z (module doc).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
