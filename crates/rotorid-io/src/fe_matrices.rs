@@ -85,7 +85,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<FeMatricesFile, ReadError> {
 
 /// Reads the matrices file at `path`, member by member; `file` names it in messages.
 pub fn read_file(file: &str, path: &Path) -> Result<FeMatricesFile, ReadError> {
-    let disk = crate::format::DiskFile::open(file, path)?;
+    let disk = crate::source::DiskFile::open(file, path)?;
     let mut found = Found::default();
     crate::npz::members(
         file,

@@ -62,6 +62,7 @@ mod par;
 pub mod parquet;
 pub mod raw;
 pub mod select;
+mod source;
 pub mod stream;
 pub mod table;
 pub mod tdms;

@@ -15,8 +15,8 @@ use std::io::Read;
 
 use crate::cursor::Cursor;
 use crate::error::ReadError;
-use crate::format::Source;
 use crate::npy;
+use crate::source::Source;
 use crate::table::Table;
 
 /// Deflate cannot expand more than this (RFC 1951: 258 bytes per two-bit code, ~1032:1).
@@ -30,7 +30,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 /// Reads the `.npz` file at `path` member by member: memory holds the channels and one
 /// member, never the whole file.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
-    let disk = crate::format::DiskFile::open(file, path)?;
+    let disk = crate::source::DiskFile::open(file, path)?;
     read_from(
         file,
         std::io::BufReader::new(disk.handle()?),

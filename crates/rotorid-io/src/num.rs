@@ -8,7 +8,7 @@
 
 use crate::cursor::Cursor;
 use crate::error::ReadError;
-use crate::format::Source;
+use crate::source::Source;
 
 /// Byte order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -69,7 +69,7 @@ fn read_file_with(
     path: &std::path::Path,
     parallel_from: u64,
 ) -> Result<Table, ReadError> {
-    let disk = crate::format::DiskFile::open(file, path)?;
+    let disk = crate::source::DiskFile::open(file, path)?;
     let handle = Positional {
         f: std::sync::Arc::new(disk.handle()?),
         size: disk.size,
@@ -91,7 +91,7 @@ fn read_file_with(
 /// chunk's offset (the whole-file reader takes what the chunk decodes to; a file that
 /// differs between the two has a footer that contradicts its pages).
 pub fn open_blocks(file: &str, path: &std::path::Path) -> Result<ParquetBlocks, ReadError> {
-    let disk = crate::format::DiskFile::open(file, path)?;
+    let disk = crate::source::DiskFile::open(file, path)?;
     let handle = Positional {
         f: std::sync::Arc::new(disk.handle()?),
         size: disk.size,

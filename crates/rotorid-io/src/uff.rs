@@ -41,7 +41,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 /// a line and a block, never the whole file. Accepts and refuses what [`read`] does, with
 /// the same messages.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
-    let disk = crate::format::DiskFile::open(file, path)?;
+    let disk = crate::source::DiskFile::open(file, path)?;
     let input = std::io::BufReader::with_capacity(1 << 16, disk.handle()?);
     read_from(file, input, disk.size)
 }

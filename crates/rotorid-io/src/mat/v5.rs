@@ -57,7 +57,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 /// top-level element (one variable), never the whole file. Accepts and refuses what
 /// [`read`] does, with the same messages.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
-    let disk = crate::format::DiskFile::open(file, path)?;
+    let disk = crate::source::DiskFile::open(file, path)?;
     let (size, read_at) = (disk.size, |at, len| disk.read_at(at, len));
     let head = read_at(0, size.min(128))?;
     let endian = header(&mut Cursor::new(file, &head))?;

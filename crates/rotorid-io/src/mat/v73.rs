@@ -29,8 +29,8 @@
 use hdf5_pure::{AttrValue, DType, Dataset, File, Group, Layout};
 
 use crate::error::ReadError;
-use crate::format::Source;
 use crate::num::{samples_at, Dtype, Endian};
+use crate::source::Source;
 use crate::table::{Channel, Table};
 
 const NUMERIC: &[&str] = &[
@@ -47,7 +47,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 /// mode: metadata and chunks read on demand), so memory holds the channels and one chunk
 /// rather than the whole file as well. Accepts and refuses what [`read`] does.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
-    let disk = crate::format::DiskFile::open(file, path)?;
+    let disk = crate::source::DiskFile::open(file, path)?;
     read_hdf5(file, &disk, || File::open_streaming(path))
 }
 

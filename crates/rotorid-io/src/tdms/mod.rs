@@ -38,8 +38,8 @@ use std::collections::HashMap;
 
 use crate::cursor::Cursor;
 use crate::error::ReadError;
-use crate::format::Source;
 use crate::num::{Dtype, Endian};
+use crate::source::Source;
 use crate::table::{Channel, Table, TimeAxis};
 
 mod daqmx;
@@ -111,7 +111,7 @@ pub fn read(file: &str, bytes: &[u8]) -> Result<Table, ReadError> {
 /// as they are read; memory holds the channels, one segment's metadata and one block,
 /// never the whole file. Accepts and refuses what [`read`] does, with the same messages.
 pub fn read_file(file: &str, path: &std::path::Path) -> Result<Table, ReadError> {
-    let disk = crate::format::DiskFile::open(file, path)?;
+    let disk = crate::source::DiskFile::open(file, path)?;
     read_from(file, &disk)
 }
 

@@ -37,8 +37,8 @@ use super::{
     Walk, BLOCK,
 };
 use crate::error::ReadError;
-use crate::format::{DiskFile, Source};
 use crate::num::{Dtype, Endian};
+use crate::source::{DiskFile, Source};
 use crate::table::ChannelInfo;
 
 /// Values of one channel in each chunk of a segment: `count` of them, the first at byte
