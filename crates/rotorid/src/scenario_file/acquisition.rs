@@ -47,7 +47,7 @@
 
 use toml_edit::{InlineTable, Item, Key, Table, Value};
 
-use super::parse::Parser;
+use super::text::Parser;
 use super::ScenarioFileError;
 use crate::acquisition::{
     probes, Acquisition, Edge, FeAcquisition, FeNodeProbes, Keyphasor, Probe, RawSettings,

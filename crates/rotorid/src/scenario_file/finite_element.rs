@@ -34,7 +34,7 @@ use toml_edit::{Item, Value};
 
 use super::acquisition::{Entries, Node, Val};
 use super::error::RotorModel;
-use super::parse::Parser;
+use super::text::Parser;
 use super::{rotor_keys, ScenarioFileError};
 use crate::model::finite_element::{
     Bearing, DofKind, FeMatrices, FeUnbalance, FiniteElementError, FiniteElementRotor,

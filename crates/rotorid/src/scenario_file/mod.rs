@@ -77,6 +77,7 @@ mod acquisition;
 mod error;
 mod finite_element;
 mod parse;
+mod text;
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -348,7 +349,7 @@ impl ScenarioSpec {
 
     /// Parse and check the TOML `text`; `origin` (the file name) prefixes every message.
     pub fn parse(origin: &str, text: &str) -> Result<Self, ScenarioFileError> {
-        parse::Parser { origin, text }.parse()
+        text::Parser { origin, text }.parse()
     }
 
     /// Where the scenario came from: `table1` or the file path.

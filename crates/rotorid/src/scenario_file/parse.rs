@@ -9,13 +9,13 @@
 //! `rotor.m = 14.29`.
 
 use std::collections::BTreeMap;
-use std::ops::Range;
 
 use toml_edit::{ImDocument, Item, Key, Value};
 
 use super::acquisition::Acquisitions;
 use super::error::RotorModel;
 use super::finite_element::{FINITE_ELEMENT, FINITE_ELEMENT_KEYS};
+use super::text::Parser;
 use super::{
     rotor_error, rotor_keys, unit_of, Num, RotorArray, ScenarioFileError, ScenarioSpec, Section,
     SpeedKind, CANONICAL_ORDER, INITIAL_KEYS, ROTOR_CONTENTS, SAMPLING_KEYS, SECTIONS, SPEED_KEYS,
@@ -23,12 +23,6 @@ use super::{
 use crate::model::ModelError;
 use crate::parameter::ModelKind;
 use crate::{Rotor, Sampling, SpeedProfile};
-
-/// Parses one scenario file's text; `origin` (the file name) prefixes every message.
-pub(super) struct Parser<'a> {
-    pub(super) origin: &'a str,
-    pub(super) text: &'a str,
-}
 
 /// One `key = value` of a section, as read from the document.
 struct Entry<'a> {
@@ -48,20 +42,6 @@ enum Raw {
 }
 
 impl Parser<'_> {
-    /// 1-based line of byte offset `pos`.
-    pub(super) fn line(&self, pos: usize) -> usize {
-        let pos = pos.min(self.text.len());
-        self.text.as_bytes()[..pos]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count()
-            + 1
-    }
-
-    pub(super) fn key_line(&self, key: Option<&Key>) -> Option<usize> {
-        key.and_then(Key::span).map(|s| self.line(s.start))
-    }
-
     /// The entry `key = value` of a section; `None` for a sub-table (`[rotor.m]`).
     fn entry<'a>(&self, key: &'a str, at: Option<&Key>, value: Option<&Value>) -> Entry<'a> {
         let raw = match value {
@@ -76,15 +56,6 @@ impl Parser<'_> {
             line: self.key_line(at),
             value: raw,
             written: self.written(value.and_then(Value::span)),
-        }
-    }
-
-    /// The source text of `span`, on one line; `{...}` for a table that has none (the
-    /// implicit table of a dotted key).
-    pub(super) fn written(&self, span: Option<Range<usize>>) -> String {
-        match span.and_then(|s| self.text.get(s)) {
-            Some(t) => t.split_whitespace().collect::<Vec<_>>().join(" "),
-            None => "{...}".to_owned(),
         }
     }
 
