@@ -3,7 +3,7 @@
 //! A thin entry point: parse the command line, run one command, and print any error as
 //! `Error: ` and its causes, each once ([`io::message`]), with a non-zero exit code.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 /// `println!` that returns an error instead of panicking when stdout cannot be written:
 /// [`io::StdoutClosed`] when its reader went away (`rotorid analyze ... | head -1`), which
@@ -31,9 +31,13 @@ static ALLOCATOR: rotorid_alloc::HugePageAdvice = rotorid_alloc::HugePageAdvice;
 mod plot;
 mod report;
 
+/// `rotorid --version`: the package version and the commit it was built from
+/// (`0.1.0 (abc1234)`; `(unknown commit)` for a build outside a git checkout; build.rs).
+const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), " (", env!("ROTORID_COMMIT"), ")");
+
 /// Identify the mass, damping and stiffness of a rotor-bearing system from its vibration.
 #[derive(Debug, Parser)]
-#[command(name = "rotorid", version, about, long_about = None)]
+#[command(name = "rotorid", version = VERSION, about, long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -73,6 +77,10 @@ enum Command {
     Worker(commands::worker::WorkerArgs),
     Fleet(commands::fleet::FleetArgs),
     Dashboard(commands::dashboard::DashboardArgs),
+    /// Print the shell completion script for bash, zsh, fish, powershell or elvish.
+    Completions(commands::completions::CompletionsArgs),
+    /// Write the manual pages (roff, section 1): rotorid.1 and one per command.
+    Manpages(commands::manpages::ManpagesArgs),
 }
 
 fn main() {
@@ -94,6 +102,8 @@ fn main() {
         Command::Worker(args) => commands::worker::run(args),
         Command::Fleet(args) => commands::fleet::run(args),
         Command::Dashboard(args) => commands::dashboard::run(args),
+        Command::Completions(args) => commands::completions::run(args, Cli::command()),
+        Command::Manpages(args) => commands::manpages::run(args, Cli::command()),
     };
     if let Err(err) = result {
         if err.is::<io::StdoutClosed>() {

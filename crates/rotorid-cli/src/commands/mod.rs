@@ -2,12 +2,14 @@
 
 pub mod analyze;
 pub mod balance;
+pub mod completions;
 pub mod condition;
 pub mod dashboard;
 pub mod demo;
 pub mod fleet;
 pub mod identify;
 pub mod inspect;
+pub mod manpages;
 pub mod onex;
 pub mod paper;
 pub mod plot;

@@ -27,6 +27,7 @@ mod raw_records;
 mod refine;
 mod safety;
 mod scenario;
+mod shell;
 mod simulate;
 mod transient;
 mod units;
