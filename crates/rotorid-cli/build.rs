@@ -17,14 +17,15 @@ fn git(args: &[&str]) -> Option<String> {
 fn main() {
     let commit = git(&["rev-parse", "--short=7", "HEAD"]);
     if let Some(dir) = git(&["rev-parse", "--git-dir"]).map(PathBuf::from) {
-        println!("cargo:rerun-if-changed={}", dir.join("HEAD").display());
+        // only files that exist: cargo re-runs a build script whose watched file is missing
+        // on every build (a fresh clone has no packed-refs, a packed branch no ref file)
+        let mut watch = vec![dir.join("HEAD"), dir.join("packed-refs")];
         if let Some(head) = git(&["symbolic-ref", "-q", "HEAD"]) {
-            println!("cargo:rerun-if-changed={}", dir.join(head).display());
+            watch.push(dir.join(head));
         }
-        println!(
-            "cargo:rerun-if-changed={}",
-            dir.join("packed-refs").display()
-        );
+        for f in watch.iter().filter(|f| f.is_file()) {
+            println!("cargo:rerun-if-changed={}", f.display());
+        }
     }
     println!(
         "cargo:rustc-env=ROTORID_COMMIT={}",
