@@ -102,6 +102,11 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         live,
         parquet,
         every: args.every.unwrap_or(1),
+        progress_bytes: if args.quiet || live {
+            None
+        } else {
+            std::fs::metadata(&args.input).ok().map(|m| m.len())
+        },
     };
     let mut ident = match stream::identify(&io, input, out, &spec, &method, args.time_tolerance) {
         Ok(i) => i,

@@ -58,10 +58,20 @@ enum Shown {
     },
 }
 
+/// What a run's steps count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    /// Samples simulated or processed.
+    Samples,
+    /// Bytes of an input file read (shown in MB / MiB).
+    Bytes,
+}
+
 /// The progress of one run of `total` steps (module doc).
 pub struct Progress {
     what: String,
     total: u64,
+    unit: Unit,
     terminal: bool,
     first_after: Duration,
     start: Instant,
@@ -70,10 +80,16 @@ pub struct Progress {
 }
 
 impl Progress {
-    /// Progress of `total` steps labelled `what` (e.g. `simulate (exact)`).
+    /// Progress of `total` samples labelled `what` (e.g. `simulate (exact)`).
     pub fn new(total: u64, what: &str) -> Self {
+        Self::counting(total, what, Unit::Samples)
+    }
+
+    /// Progress of `total` steps of `unit` labelled `what` (e.g. `identify`).
+    pub fn counting(total: u64, what: &str, unit: Unit) -> Self {
         let mut p = Self::with_terminal(total, what, std::io::stderr().is_terminal());
         p.first_after = first_report_after();
+        p.unit = unit;
         p
     }
 
@@ -81,6 +97,7 @@ impl Progress {
         Self {
             what: what.to_owned(),
             total: total.max(1),
+            unit: Unit::Samples,
             terminal,
             first_after: FIRST_REPORT_AFTER,
             start: Instant::now(),
@@ -107,7 +124,7 @@ impl Progress {
         match &mut self.shown {
             Shown::Nothing if elapsed < self.first_after => None,
             Shown::Nothing if self.terminal => {
-                self.shown = Shown::Bar(bar(self.total, &self.what, done));
+                self.shown = Shown::Bar(bar(self.total, &self.what, self.unit, done));
                 None
             }
             Shown::Nothing => {
@@ -130,11 +147,18 @@ impl Progress {
     }
 
     fn line(&self, done: u64, elapsed: Duration) -> String {
+        let of = match self.unit {
+            Unit::Samples => format!("{done} of {} samples", self.total),
+            Unit::Bytes => format!(
+                "{:.1} of {:.1} MB read",
+                done.min(self.total) as f64 / 1e6,
+                self.total as f64 / 1e6
+            ),
+        };
         format!(
-            "{}: {}% ({done} of {} samples), {} s elapsed",
+            "{}: {}% ({of}), {} s elapsed",
             self.what,
             done.min(self.total) * 100 / self.total,
-            self.total,
             elapsed.as_secs()
         )
     }
@@ -147,11 +171,14 @@ impl Progress {
     }
 }
 
-fn bar(total: u64, what: &str, done: u64) -> ProgressBar {
+fn bar(total: u64, what: &str, unit: Unit, done: u64) -> ProgressBar {
     let pb = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    let style = ProgressStyle::with_template(
-        "{msg} [{bar:40}] {human_pos}/{human_len} samples, {elapsed} elapsed, eta {eta}",
-    )
+    let style = ProgressStyle::with_template(match unit {
+        Unit::Samples => {
+            "{msg} [{bar:40}] {human_pos}/{human_len} samples, {elapsed} elapsed, eta {eta}"
+        }
+        Unit::Bytes => "{msg} [{bar:40}] {bytes}/{total_bytes} read, {elapsed} elapsed, eta {eta}",
+    })
     .map(|s| s.progress_chars("=> "))
     .unwrap_or_else(|_| ProgressStyle::default_bar());
     pb.set_style(style);
@@ -179,6 +206,17 @@ mod tests {
         assert_eq!(p.report(301, at(4000)), None);
         assert!(p.report(302, at(13_200)).unwrap().contains("13 s elapsed"));
         assert!(p.report(1000, at(13_300)).unwrap().contains("100%"));
+    }
+
+    #[test]
+    fn bytes_read_are_shown_in_megabytes() {
+        let mut p = Progress::with_terminal(45_800_000, "identify", false);
+        p.unit = Unit::Bytes;
+        let later = p.start + Duration::from_secs(3);
+        assert_eq!(
+            p.report(18_320_000, later).as_deref(),
+            Some("identify: 40% (18.3 of 45.8 MB read), 3 s elapsed")
+        );
     }
 
     #[test]

@@ -931,3 +931,58 @@ fn a_slow_simulation_reports_progress_without_a_terminal() {
     eprintln!("{}", lines.join("\n"));
     assert!(m.stdout.is_empty());
 }
+
+#[test]
+fn identify_of_a_csv_file_reports_its_reading_progress_and_not_under_q() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("r.csv");
+    std::fs::write(&csv, simulate(&["--scenario", "table1", "--duration", "2"])).unwrap();
+    let size = std::fs::metadata(&csv).unwrap().len() as f64 / 1e6;
+    let run = |quiet: bool, out: &Path| {
+        let mut cmd = Command::new(bin());
+        // the first report at once, so that the test does not depend on the machine's speed
+        cmd.env("ROTORID_PROGRESS_AFTER_S", "0")
+            .arg("identify")
+            .arg(&csv)
+            .args(["--scenario", "table1", "--every", "100", "--out"])
+            .arg(out);
+        if quiet {
+            cmd.arg("-q");
+        }
+        let out = cmd.output().unwrap();
+        (
+            out.status.success(),
+            out.stdout,
+            String::from_utf8(out.stderr).unwrap(),
+        )
+    };
+    let (ok, stdout, stderr) = run(false, &dir.path().join("a.csv"));
+    assert!(ok, "{stderr}");
+    assert!(stdout.is_empty(), "stdout: {stdout:?}");
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("identify: "))
+        .collect();
+    assert!(!lines.is_empty(), "no progress line: {stderr}");
+    let percents: Vec<u64> = lines
+        .iter()
+        .map(|l| l["identify: ".len()..l.find('%').unwrap()].parse().unwrap())
+        .collect();
+    assert!(percents.windows(2).all(|w| w[0] <= w[1]), "{lines:?}");
+    assert_eq!(*percents.last().unwrap(), 100, "{lines:?}");
+    assert!(
+        lines
+            .last()
+            .unwrap()
+            .contains(&format!("({size:.1} of {size:.1} MB read)")),
+        "{lines:?}"
+    );
+    let (ok, _, quiet) = run(true, &dir.path().join("b.csv"));
+    assert!(ok, "{quiet}");
+    assert!(!quiet.contains("identify: "), "progress under -q: {quiet}");
+    // the outputs do not depend on whether progress is shown
+    assert_eq!(
+        std::fs::read(dir.path().join("a.csv")).unwrap(),
+        std::fs::read(dir.path().join("b.csv")).unwrap()
+    );
+}

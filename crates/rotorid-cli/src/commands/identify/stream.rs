@@ -25,6 +25,7 @@ use rotorid::pipeline::{
 use rotorid::SpeedProfile;
 
 use crate::io::estimates_csv::estimates_parquet;
+use crate::io::progress::{Progress, Unit};
 use crate::io::{CsvError, EstimateRow, EstimatesWriter, Output, ResponseReader, ScenarioSpec};
 
 /// Rows a reader thread parses before it hands them over.
@@ -49,6 +50,9 @@ pub(crate) struct Io<'a> {
     pub parquet: bool,
     /// Write every N-th algebraic estimate.
     pub every: u64,
+    /// Show progress on stderr (`io::progress`) against this input size \[bytes\]: a
+    /// regular CSV file, not under `-q`.
+    pub progress_bytes: Option<u64>,
 }
 
 /// What the reader's pre-read hook and the row loop share.
@@ -313,6 +317,14 @@ fn read_all_threaded(
     state: &Rc<RefCell<State>>,
     profile: Option<SpeedProfile>,
 ) -> anyhow::Result<()> {
+    let read = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+    let input = CountingReader {
+        inner: input,
+        read: std::sync::Arc::clone(&read),
+    };
+    let mut progress = io
+        .progress_bytes
+        .map(|total| Progress::counting(total, "identify", Unit::Bytes));
     let mut reader = open_rows(io, input, profile)?;
     type Batch = Result<Vec<crate::io::response_csv::ResponseRow>, CsvError>;
     let (tx, rx) = std::sync::mpsc::sync_channel::<Batch>(BATCHES_AHEAD);
@@ -349,9 +361,31 @@ fn read_all_threaded(
             for row in batch? {
                 push_row(io, state, &row)?;
             }
+            if let Some(p) = &mut progress {
+                p.update(read.load(std::sync::atomic::Ordering::Relaxed));
+            }
+        }
+        if let Some(p) = progress {
+            p.finish();
         }
         Ok(())
     })
+}
+
+/// A reader that counts the bytes read through it (for the progress of the reading
+/// thread, seen from the identifying one).
+struct CountingReader<R> {
+    inner: R,
+    read: std::sync::Arc<std::sync::atomic::AtomicU64>,
+}
+
+impl<R: Read> Read for CountingReader<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.read
+            .fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed);
+        Ok(n)
+    }
 }
 
 /// One sample into the session; `at` locates a refused sample's message (its line or
