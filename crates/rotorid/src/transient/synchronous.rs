@@ -219,14 +219,33 @@ impl Premultiplied {
     /// M^-1 (K + w' Ka): W'' = b - A1 W' - A0 W.
     fn coefficients(&self, w: f64, wd: f64) -> (DMatrix<C64>, DMatrix<C64>) {
         let n = self.c.nrows();
-        let cw = &self.c + &self.g * Complex::new(w, 0.0);
-        let eye = DMatrix::<C64>::identity(n, n);
-        let a1 = &cw + &eye * Complex::new(0.0, 2.0 * w);
-        let a0 = &eye * Complex::new(-w * w, wd)
-            + &cw * Complex::new(0.0, w)
-            + &self.k
-            + &self.ka * Complex::new(wd, 0.0);
+        let mut a1 = DMatrix::zeros(n, n);
+        let mut a0 = DMatrix::zeros(n, n);
+        self.coefficients_into(w, wd, &mut a1, &mut a0);
         (a1, a0)
+    }
+
+    /// [`Premultiplied::coefficients`] into `a1`, `a0` (n x n), without allocating: the
+    /// right-hand side's hot path. Element by element the same operations in the same
+    /// order as the matrix expressions (identity entries 1 and 0 included), so the
+    /// results are the same to the bit.
+    fn coefficients_into(&self, w: f64, wd: f64, a1: &mut DMatrix<C64>, a0: &mut DMatrix<C64>) {
+        let n = self.c.nrows();
+        let (iw2, sq, iw, wd_c) = (
+            Complex::new(0.0, 2.0 * w),
+            Complex::new(-w * w, wd),
+            Complex::new(0.0, w),
+            Complex::new(wd, 0.0),
+        );
+        let wc = Complex::new(w, 0.0);
+        for c in 0..n {
+            for r in 0..n {
+                let e = Complex::new(if r == c { 1.0 } else { 0.0 }, 0.0);
+                let cw = self.c[(r, c)] + self.g[(r, c)] * wc;
+                a1[(r, c)] = cw + e * iw2;
+                a0[(r, c)] = e * sq + cw * iw + self.k[(r, c)] + self.ka[(r, c)] * wd_c;
+            }
+        }
     }
 }
 
@@ -293,6 +312,30 @@ struct Rhs<'a> {
     pre: &'a Premultiplied,
     history: &'a History,
     n: usize,
+    /// Buffers of [`Rhs::eval`], reused from call to call.
+    scratch: std::cell::RefCell<Scratch>,
+}
+
+/// [`Rhs::eval`]'s working memory: A1, A0 and three vectors of n.
+struct Scratch {
+    a1: DMatrix<C64>,
+    a0: DMatrix<C64>,
+    acc: Vec<C64>,
+    f: Vec<C64>,
+    e: Vec<C64>,
+}
+
+impl Scratch {
+    fn new(n: usize) -> Self {
+        let zero = Complex::new(0.0, 0.0);
+        Self {
+            a1: DMatrix::from_element(n, n, zero),
+            a0: DMatrix::from_element(n, n, zero),
+            acc: vec![zero; n],
+            f: vec![zero; n],
+            e: vec![zero; n],
+        }
+    }
 }
 
 fn mul_add(out: &mut [C64], m: &DMatrix<C64>, v: &[C64], scale: C64) {
@@ -310,22 +353,27 @@ impl Rhs<'_> {
     fn eval(&self, t: f64, y: &[C64], dy: &mut [C64]) {
         let n = self.n;
         let (w, wd) = self.history.at(t);
-        let (a1, a0) = self.pre.coefficients(w, wd);
+        let mut guard = self.scratch.borrow_mut();
+        let Scratch { a1, a0, acc, f, e } = &mut *guard;
+        self.pre.coefficients_into(w, wd, a1, a0);
         let minus = Complex::new(-1.0, 0.0);
+        let zero = Complex::new(0.0, 0.0);
         let force = Complex::new(w * w, -wd);
         // W' and W''
         let (wv, vv) = (&y[..n], &y[n..2 * n]);
         dy[..n].copy_from_slice(vv);
-        let mut acc: Vec<C64> = self.pre.p.iter().map(|p| p * force).collect();
-        mul_add(&mut acc, &a1, vv, minus);
-        mul_add(&mut acc, &a0, wv, minus);
-        dy[n..2 * n].copy_from_slice(&acc);
-        let wdd = acc;
+        for (a, p) in acc.iter_mut().zip(self.pre.p.iter()) {
+            *a = p * force;
+        }
+        mul_add(acc, a1, vv, minus);
+        mul_add(acc, a0, wv, minus);
+        dy[n..2 * n].copy_from_slice(acc);
+        let wdd = &*acc;
         for (j, d) in self.pre.d.iter().enumerate() {
             let base = 2 * n * (j + 1);
             let (s, u) = (&y[base..base + n], &y[base + n..base + 2 * n]);
             dy[base..base + n].copy_from_slice(u);
-            let mut f = vec![Complex::new(0.0, 0.0); n];
+            f.fill(zero);
             if let Some(dp) = &d.p {
                 for (fi, p) in f.iter_mut().zip(dp.iter()) {
                     *fi += p * force;
@@ -333,36 +381,34 @@ impl Rhs<'_> {
             }
             if let Some(dm) = &d.m {
                 // dM (W'' + 2 i w W' + (i w' - w^2) W)
-                let e: Vec<C64> = (0..n)
-                    .map(|i| {
-                        wdd[i]
-                            + vv[i] * Complex::new(0.0, 2.0 * w)
-                            + wv[i] * Complex::new(-w * w, wd)
-                    })
-                    .collect();
-                mul_add(&mut f, dm, &e, minus);
+                for (i, ei) in e.iter_mut().enumerate() {
+                    *ei = wdd[i]
+                        + vv[i] * Complex::new(0.0, 2.0 * w)
+                        + wv[i] * Complex::new(-w * w, wd);
+                }
+                mul_add(f, dm, e, minus);
             }
             if d.c.is_some() || d.g.is_some() {
                 // (dC + w dG) (W' + i w W)
-                let e: Vec<C64> = (0..n)
-                    .map(|i| vv[i] + wv[i] * Complex::new(0.0, w))
-                    .collect();
+                for (i, ei) in e.iter_mut().enumerate() {
+                    *ei = vv[i] + wv[i] * Complex::new(0.0, w);
+                }
                 if let Some(dc) = &d.c {
-                    mul_add(&mut f, dc, &e, minus);
+                    mul_add(f, dc, e, minus);
                 }
                 if let Some(dg) = &d.g {
-                    mul_add(&mut f, dg, &e, Complex::new(-w, 0.0));
+                    mul_add(f, dg, e, Complex::new(-w, 0.0));
                 }
             }
             if let Some(dk) = &d.k {
-                mul_add(&mut f, dk, wv, minus);
+                mul_add(f, dk, wv, minus);
             }
             if let Some(dka) = &d.ka {
-                mul_add(&mut f, dka, wv, Complex::new(-wd, 0.0));
+                mul_add(f, dka, wv, Complex::new(-wd, 0.0));
             }
-            mul_add(&mut f, &a1, u, minus);
-            mul_add(&mut f, &a0, s, minus);
-            dy[base + n..base + 2 * n].copy_from_slice(&f);
+            mul_add(f, a1, u, minus);
+            mul_add(f, a0, s, minus);
+            dy[base + n..base + 2 * n].copy_from_slice(f);
         }
     }
 }
@@ -535,6 +581,7 @@ pub fn synchronous(
                 pre: &pre,
                 history: &history,
                 n,
+                scratch: std::cell::RefCell::new(Scratch::new(n)),
             };
             let m = 2 * n * (np + 1);
             let mut k: [Vec<C64>; 5] = std::array::from_fn(|_| vec![Complex::new(0.0, 0.0); m]);
