@@ -261,6 +261,9 @@ struct History {
     /// The shaft angle at each t \[rad\] from the first (the trapezoid rule, exact on a
     /// linear speed).
     angle: Vec<f64>,
+    /// The stretch of the last look-up ([`History::stretch`]): the integration asks for
+    /// times in order, so the next one is nearly always in it or the one after.
+    last: std::cell::Cell<usize>,
 }
 
 impl History {
@@ -269,7 +272,30 @@ impl History {
         for i in 1..t.len() {
             angle[i] = angle[i - 1] + 0.5 * (w[i - 1] + w[i]) * (t[i] - t[i - 1]);
         }
-        Self { t, w, angle }
+        Self {
+            t,
+            w,
+            angle,
+            last: std::cell::Cell::new(1),
+        }
+    }
+
+    /// The stretch `i` (from point `i - 1` to point `i`, 1 <= i <= n - 1, the end
+    /// stretches extended) holding `t`: `partition_point(x <= t)` clamped to 1..n-1, found
+    /// from the last look-up's stretch or the one after it before searching.
+    fn stretch(&self, t: f64) -> usize {
+        let n = self.t.len();
+        let holds = |i: usize| (i == 1 || self.t[i - 1] <= t) && (i == n - 1 || t < self.t[i]);
+        let last = self.last.get();
+        let i = if last < n && holds(last) {
+            last
+        } else if last + 1 < n && holds(last + 1) {
+            last + 1
+        } else {
+            self.t.partition_point(|&x| x <= t).clamp(1, n - 1)
+        };
+        self.last.set(i);
+        i
     }
 
     /// The shaft angle at `t` \[rad\] (from the first point's middle).
@@ -278,7 +304,7 @@ impl History {
         if n == 1 {
             return self.w[0] * (t - self.t[0]);
         }
-        let i = self.t.partition_point(|&x| x <= t).clamp(1, n - 1);
+        let i = self.stretch(t);
         let (t0, w0) = (self.t[i - 1], self.w[i - 1]);
         let slope = self.slope(i);
         let d = t - t0;
@@ -301,7 +327,7 @@ impl History {
         if n == 1 {
             return (self.w[0], 0.0);
         }
-        let i = self.t.partition_point(|&x| x <= t).clamp(1, n - 1);
+        let i = self.stretch(t);
         let slope = self.slope(i);
         (self.w[i - 1] + slope * (t - self.t[i - 1]), slope)
     }
@@ -650,6 +676,27 @@ pub fn synchronous(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The stretch found from the last look-up is the binary search's, for times in
+    /// order, repeated, backwards, outside the points and at them.
+    #[test]
+    fn a_stretch_from_the_last_one_is_the_searched_one() {
+        let t: Vec<f64> = vec![0.0, 0.1, 0.25, 0.25, 0.4, 0.7, 1.0];
+        let h = History::new(t.clone(), vec![1.0; t.len()]);
+        let mut x: u64 = 0x2545_F491_4F6C_DD1D;
+        let mut queries: Vec<f64> = (0..=240).map(|k| -0.1 + k as f64 * 0.005).collect();
+        queries.extend(t.iter().copied());
+        queries.extend((0..200).map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 1.4 - 0.2
+        }));
+        for q in queries {
+            let searched = t.partition_point(|&v| v <= q).clamp(1, t.len() - 1);
+            assert_eq!(h.stretch(q), searched, "t = {q}");
+        }
+    }
     use crate::model::description::{ModalDescription, Mode};
 
     /// Revolutions of psi = w0 t + a t^2 / 2 from t = 0: their intervals and mid speeds.
