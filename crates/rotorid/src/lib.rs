@@ -1,20 +1,35 @@
 //! # rotorid
 //!
 //! Identification of the physical parameters of rotor-bearing systems (mass, damping,
-//! stiffness, unbalance) from measured vibration, after Barredo et al. (2024).
+//! stiffness, bearing coefficients, unbalance) from measured vibration, after Barredo et
+//! al. (2024), and the analyses that use them.
 //!
-//! - [`model`]: the 2-DOF Jeffcott rotor of the paper's eq. (1), speed profiles, scenarios.
-//! - [`simulate`]: Newmark (as in the paper) and an exact/high-accuracy reference, noise.
-//! - [`identify`]: running integrals and the algebraic identifiers, streaming and batch.
-//! - [`refine`]: output-error (maximum-likelihood) refinement with uncertainties.
+//! - [`model`]: the rotors: the paper's 2-DOF Jeffcott rotor (eq. (1)) and its
+//!   cross-coupled-bearing case, finite-element rotors (matrices from ROSS or elsewhere,
+//!   bearings and unbalances as data), modal descriptions; speed profiles, scenarios;
+//!   `model::description`, the model as data (matrices and their derivatives for a
+//!   parameter vector).
+//! - [`parameter`]: one name, unit and sign for every identified parameter.
+//! - [`simulate`]: Newmark (as in the paper) and exact/high-accuracy references, noise;
+//!   finite-element rotors.
+//! - [`acquisition`]: raw records (probe volts, keyphasor, slow roll) to displacement and
+//!   shaft angle.
+//! - [`identify`]: the algebraic and modulating-function identifiers, streaming and batch.
+//! - [`refine`]: maximum-likelihood refinement with uncertainties, the Cramer-Rao bound;
+//!   finite-element rotors.
+//! - [`residual`]: whether a model's residuals are only the data's noise (the adequacy
+//!   tests every method uses).
 //! - [`pipeline`]: record -> identification with diagnostics, the entry point of every
 //!   caller (batch [`pipeline::identify`] and streaming [`pipeline::Session`]).
-//! - [`analysis`]: Campbell diagram, critical speeds, stability, unbalance response, balancing.
-//! - `scenario_file` (feature `toml`): scenario files (rotor, speed, sampling, initial
-//!   state) parsed from TOML text, with errors naming file, line, key and allowed range.
+//! - [`analysis`]: Campbell diagram, critical speeds, stability, unbalance response,
+//!   balancing.
+//! - [`transient`]: run-ups and coast-downs: order tracking, Bode and polar data, critical
+//!   speeds with API 684 amplification factors and margins, modes fitted to the sweep.
+//! - `scenario_file` (feature `toml`): scenario files parsed from TOML text, with errors
+//!   naming file, line, key and allowed range.
 //!
-//! Pure computation: no file I/O (callers read files and hand over their text), no
-//! plotting (those live in the `rotorid` command).
+//! Pure computation: no file I/O (callers read files and hand over their text or
+//! samples), no plotting (those live in the `rotorid` command).
 
 pub mod acquisition;
 pub mod analysis;

@@ -21,21 +21,37 @@ fn commands_in_help() -> Vec<String> {
         .collect()
 }
 
+/// The abbreviated commit `rotorid --version` names is HEAD or one of its ancestors (a
+/// commit made while the tests run leaves the binary one behind), or `unknown commit`
+/// when the source is not a git checkout.
 #[test]
 fn version_names_the_commit_it_was_built_from() {
     let out = rotorid().arg("--version").output().unwrap();
     assert!(out.status.success());
-    let commit = Command::new("git")
-        .args(["rev-parse", "--short=7", "HEAD"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map(|o| String::from_utf8(o.stdout).unwrap().trim().to_owned())
-        .unwrap_or_else(|| "unknown commit".to_owned());
-    assert_eq!(
-        String::from_utf8(out.stdout).unwrap(),
-        format!("rotorid {} ({commit})\n", env!("CARGO_PKG_VERSION"))
+    let text = String::from_utf8(out.stdout).unwrap();
+    let prefix = format!("rotorid {} (", env!("CARGO_PKG_VERSION"));
+    let commit = text
+        .strip_prefix(&prefix)
+        .and_then(|r| r.strip_suffix(")\n"))
+        .unwrap_or_else(|| panic!("--version printed {text:?}"));
+    let git = |args: &[&str]| {
+        Command::new("git")
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .ok()
+    };
+    let in_git = git(&["rev-parse", "HEAD"]).is_some_and(|o| o.status.success());
+    if !in_git {
+        assert_eq!(commit, "unknown commit");
+        return;
+    }
+    assert_eq!(commit.len(), 7, "{commit:?}");
+    assert!(commit.bytes().all(|b| b.is_ascii_hexdigit()), "{commit:?}");
+    let ancestor = git(&["merge-base", "--is-ancestor", commit, "HEAD"]).unwrap();
+    assert!(
+        ancestor.status.success(),
+        "{commit} is not HEAD or an ancestor of it"
     );
 }
 

@@ -1,5 +1,9 @@
-//! The rotor-bearing model of Barredo et al. (2024), eq. (1): a 2-DOF Jeffcott rotor
-//! (Lalanne & Ferraris' "simple rotor") with gyroscopic coupling, driven by unbalance.
+//! The rotor-bearing models. First the one of Barredo et al. (2024), eq. (1): a 2-DOF
+//! Jeffcott rotor (Lalanne & Ferraris' "simple rotor") with gyroscopic coupling, driven
+//! by unbalance; with cross-coupled bearings ([`CrossCoupling`]) its K and C gain
+//! off-diagonal terms. Finite-element rotors are in [`finite_element`]; every rotor can be
+//! written as a [`description::RotorDescription`] (matrices and their derivatives for a
+//! parameter vector), which the transient's mode fit already uses.
 //!
 //! ```text
 //! M q'' + C(w) q' + K(w') q = F(t),     q = (x, z)  [m]
