@@ -244,12 +244,8 @@ mod tests {
     use super::*;
     use crate::model::{InitialState, Rotor};
 
-    /// The Van Loan derivative agrees with a central difference of exp(A(theta) dt), for
-    /// every parameter of the cross-coupled model.
-    #[test]
-    fn frechet_derivative_matches_central_difference() {
-        let w = 125.0;
-        let dt = 1e-4;
+    /// Table 1 on cross-coupled bearings, every parameter of that model unknown.
+    fn cross_coupled() -> (Theta, Columns) {
         let mut p = Rotor::table1().params();
         p.coupling = Some(crate::model::CrossCoupling {
             cxz: 3.0,
@@ -266,6 +262,16 @@ mod tests {
             ..super::super::Unknowns::all()
         };
         let cols = Columns::new(&u, crate::parameter::ModelKind::CrossCoupled);
+        (t0, cols)
+    }
+
+    /// The Van Loan derivative agrees with a central difference of exp(A(theta) dt), for
+    /// every parameter of the cross-coupled model.
+    #[test]
+    fn frechet_derivative_matches_central_difference() {
+        let w = 125.0;
+        let dt = 1e-4;
+        let (t0, cols) = cross_coupled();
         let osc = [[0.0, 1.0]];
         let st = ExactStep::new(&t0, &cols, w, dt, &osc, false);
         for (j, &kind) in cols.kinds()[..cols.nphys].iter().enumerate() {
@@ -298,22 +304,7 @@ mod tests {
     #[test]
     fn balanced_steps_are_the_plain_ones() {
         let w = 125.0;
-        let mut p = Rotor::table1().params();
-        p.coupling = Some(crate::model::CrossCoupling {
-            cxz: 3.0,
-            czx: -2.0,
-            kxz: 1.0e5,
-            kzx: -1.2e5,
-        });
-        let t0 = Theta::new(&p, &InitialState::default());
-        let u = super::super::Unknowns {
-            cxz: true,
-            czx: true,
-            kxz: true,
-            kzx: true,
-            ..super::super::Unknowns::all()
-        };
-        let cols = Columns::new(&u, crate::parameter::ModelKind::CrossCoupled);
+        let (t0, cols) = cross_coupled();
         let osc = [[0.0, 1.0]];
         for dt in [1e-4, 27e-4] {
             let plain = ExactStep::new(&t0, &cols, w, dt, &osc, false);
