@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # End to end, `rotorid identify` (the algebraic method, every check on, the adequacy
 # verdict included) against `rotorid inspect` of the same file (reading and parsing every
-# value, identifying nothing: the floor), on the 1,000,001-row response CSV of issue 38
+# value, identifying nothing: the floor), on a 1,000,001-row response CSV
 # (`rotorid simulate` of the paper's rotor at 1200 rpm, 100 s at 10 kHz, the paper's
 # Newmark integrator), both single processes as a user runs them, timed in turn (A B A B
 # ...) in one run; prints medians (wall, and CPU: user + system of the child) and the

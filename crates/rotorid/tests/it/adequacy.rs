@@ -391,7 +391,7 @@ fn the_algebraic_method_calls_a_wrong_model_inadequate_though_its_estimates_neve
 fn a_noise_free_record_keeps_its_values_with_a_note_on_what_the_test_cannot_tell() {
     // the paper's rotor through the paper's Newmark integrator, noise-free: eq. (1) misses
     // the record by the integrator's period error (~1e-5 of the signal), hundreds of times
-    // the noise the fourth differences see (rounding); every value used to be withheld
+    // the noise the fourth differences see (rounding), which the tests alone would reject
     let s = Scenario::table1();
     let r = rotorid::simulate::simulate(&s, rotorid::simulate::Method::Newmark).unwrap();
     let rec = Record::from_response(&r).unwrap();
