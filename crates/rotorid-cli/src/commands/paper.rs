@@ -14,12 +14,12 @@
 //!
 //! See [`crate::report`] for the experiments and definitions.
 
-use std::io::{IsTerminal, Write as _};
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
-use indicatif::{ProgressBar, ProgressStyle};
 
+use crate::io::progress::{Progress, Unit};
 use crate::io::{FileMode, Output};
 use crate::plot;
 use crate::report::experiment::{self, Case, Run, Setting, PAPER_DT};
@@ -46,7 +46,7 @@ pub struct PaperArgs {
     /// Record length in seconds, at least 0.3 (the estimates are read at 0.3 s).
     #[arg(long, value_name = "S", default_value_t = 1.0)]
     pub duration: f64,
-    /// No progress bar and no summary on stdout.
+    /// No progress on stderr and no summary on stdout.
     #[arg(long)]
     pub quiet: bool,
 }
@@ -67,7 +67,7 @@ pub fn run(args: PaperArgs) -> anyhow::Result<()> {
     let figures_per_case = 8;
     let runs_per_case = Setting::COMBINATIONS.len();
     let steps = Case::ALL.len() * (runs_per_case + figures_per_case) + 3;
-    let bar = progress_bar(steps as u64, args.quiet)?;
+    let mut progress = Steps::new(steps as u64, args.quiet);
 
     // Per case: simulate and identify in every combination of data and rule, draw the
     // figures from the paper's setting and ours.
@@ -76,21 +76,15 @@ pub fn run(args: PaperArgs) -> anyhow::Result<()> {
     for case in Case::ALL {
         let mut by_setting = Vec::new();
         for setting in Setting::COMBINATIONS {
-            bar.set_message(format!(
-                "simulate + identify: {}, {}",
-                case.name(),
-                setting.name()
-            ));
             let run = experiment::run(case, setting, duration)?;
             attribution.push(attribution_of(&run));
             by_setting.push(run);
-            bar.inc(1);
+            progress.step();
         }
         let ours = take(&mut by_setting, Setting::Ours);
         let paper = take(&mut by_setting, Setting::Paper);
         responses.push(compare_responses(&paper, &ours));
         for f in case_figures(case, &paper, &ours) {
-            bar.set_message(format!("drawing {}", f.stem));
             let (png, svg) = (format!("{}.png", f.stem), format!("{}.svg", f.stem));
             plot::save(&f.figure, &dir.join(&png))?;
             plot::save(&f.figure, &dir.join(&svg))?;
@@ -102,7 +96,7 @@ pub fn run(args: PaperArgs) -> anyhow::Result<()> {
                 png,
                 svg,
             });
-            bar.inc(1);
+            progress.step();
         }
         runs.push(paper);
         runs.push(ours);
@@ -156,16 +150,14 @@ pub fn run(args: PaperArgs) -> anyhow::Result<()> {
         attribution,
         figures,
     };
-
-    bar.set_message("writing results.json, report.md, report.html");
     let json = serde_json::to_string_pretty(&report).context("cannot serialise the results")?;
     write(dir, "results.json", json + "\n")?;
-    bar.inc(1);
+    progress.step();
     write(dir, "report.md", markdown::render(&report))?;
-    bar.inc(1);
+    progress.step();
     write(dir, "report.html", html::render(&report, dir)?)?;
-    bar.inc(1);
-    bar.finish_and_clear();
+    progress.step();
+    progress.finish();
 
     if !args.quiet {
         outln!(
@@ -202,13 +194,32 @@ fn write(dir: &Path, name: &str, contents: String) -> anyhow::Result<()> {
     out.commit()
 }
 
-/// A bar on stderr when it is a terminal and not `--quiet`; hidden otherwise.
-fn progress_bar(len: u64, quiet: bool) -> anyhow::Result<ProgressBar> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return Ok(ProgressBar::hidden());
+/// The run's progress on stderr (`io::progress`: a bar on a terminal, lines otherwise,
+/// once the run has taken 2 s), nothing under `--quiet`.
+struct Steps {
+    progress: Option<Progress>,
+    done: u64,
+}
+
+impl Steps {
+    fn new(total: u64, quiet: bool) -> Self {
+        Self {
+            progress: (!quiet).then(|| Progress::counting(total, "paper", Unit::Steps)),
+            done: 0,
+        }
     }
-    let style = ProgressStyle::with_template("{elapsed:>4} [{bar:32}] {pos}/{len} {msg}")
-        .context("progress bar template")?
-        .progress_chars("=> ");
-    Ok(ProgressBar::new(len).with_style(style))
+
+    /// One more step done.
+    fn step(&mut self) {
+        self.done += 1;
+        if let Some(p) = &mut self.progress {
+            p.update(self.done);
+        }
+    }
+
+    fn finish(self) {
+        if let Some(p) = self.progress {
+            p.finish();
+        }
+    }
 }

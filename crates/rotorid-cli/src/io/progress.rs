@@ -65,6 +65,8 @@ pub enum Unit {
     Samples,
     /// Bytes of an input file read (shown in MB / MiB).
     Bytes,
+    /// Steps of a run made of a few long ones (`paper`'s simulations and figures).
+    Steps,
 }
 
 /// The progress of one run of `total` steps (module doc).
@@ -76,6 +78,8 @@ pub struct Progress {
     first_after: Duration,
     start: Instant,
     next_check: u64,
+    /// Steps between two looks at the clock ([`CHECK_STRIDE`] for samples, else 1).
+    stride: u64,
     shown: Shown,
 }
 
@@ -90,6 +94,11 @@ impl Progress {
         let mut p = Self::with_terminal(total, what, std::io::stderr().is_terminal());
         p.first_after = first_report_after();
         p.unit = unit;
+        if unit != Unit::Samples {
+            // each update stands for much work: look at the clock every time
+            p.next_check = 1;
+            p.stride = 1;
+        }
         p
     }
 
@@ -102,6 +111,7 @@ impl Progress {
             first_after: FIRST_REPORT_AFTER,
             start: Instant::now(),
             next_check: CHECK_STRIDE,
+            stride: CHECK_STRIDE,
             shown: Shown::Nothing,
         }
     }
@@ -111,7 +121,7 @@ impl Progress {
         if done < self.next_check {
             return;
         }
-        self.next_check = done + CHECK_STRIDE;
+        self.next_check = done + self.stride;
         if let Some(line) = self.report(done, Instant::now()) {
             eprintln!("{line}");
         }
@@ -154,6 +164,7 @@ impl Progress {
                 done.min(self.total) as f64 / 1e6,
                 self.total as f64 / 1e6
             ),
+            Unit::Steps => format!("{done} of {} steps", self.total),
         };
         format!(
             "{}: {}% ({of}), {} s elapsed",
@@ -178,6 +189,7 @@ fn bar(total: u64, what: &str, unit: Unit, done: u64) -> ProgressBar {
             "{msg} [{bar:40}] {human_pos}/{human_len} samples, {elapsed} elapsed, eta {eta}"
         }
         Unit::Bytes => "{msg} [{bar:40}] {bytes}/{total_bytes} read, {elapsed} elapsed, eta {eta}",
+        Unit::Steps => "{msg} [{bar:40}] {pos}/{len} steps, {elapsed} elapsed, eta {eta}",
     })
     .map(|s| s.progress_chars("=> "))
     .unwrap_or_else(|_| ProgressStyle::default_bar());
@@ -216,6 +228,19 @@ mod tests {
         assert_eq!(
             p.report(18_320_000, later).as_deref(),
             Some("identify: 40% (18.3 of 45.8 MB read), 3 s elapsed")
+        );
+    }
+
+    #[test]
+    fn steps_are_counted_and_each_update_looks_at_the_clock() {
+        let p = Progress::counting(27, "paper", Unit::Steps);
+        assert_eq!((p.stride, p.next_check), (1, 1));
+        let mut p = Progress::with_terminal(27, "paper", false);
+        p.unit = Unit::Steps;
+        let later = p.start + Duration::from_secs(3);
+        assert_eq!(
+            p.report(27, later).as_deref(),
+            Some("paper: 100% (27 of 27 steps), 3 s elapsed")
         );
     }
 

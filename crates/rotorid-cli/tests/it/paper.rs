@@ -175,3 +175,36 @@ fn paper_rejects_a_short_duration_and_an_unusable_directory() {
             "cannot create the output directory",
         ));
 }
+
+#[test]
+fn paper_reports_its_progress_without_a_terminal_unless_quiet() {
+    let dir = tempfile::tempdir().unwrap();
+    // the first report at once, so that the test does not depend on the machine's speed
+    let out = rotorid()
+        .env("ROTORID_PROGRESS_AFTER_S", "0")
+        .args(["paper", "--duration", "0.3", "--out"])
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    let done: Vec<(u64, u64)> = stderr
+        .lines()
+        .filter_map(|l| l.strip_prefix("paper: "))
+        .map(|l| {
+            let inner = &l[l.find('(').unwrap() + 1..l.find(" steps)").unwrap()];
+            let (a, b) = inner.split_once(" of ").unwrap();
+            (a.parse().unwrap(), b.parse().unwrap())
+        })
+        .collect();
+    assert!(!done.is_empty(), "no progress line: {stderr}");
+    assert!(done.windows(2).all(|w| w[0].0 < w[1].0), "{stderr}");
+    let (last, total) = *done.last().unwrap();
+    assert_eq!(last, total, "{stderr}");
+    // the summary still goes to stdout
+    assert!(!out.stdout.is_empty());
+}
