@@ -237,13 +237,27 @@ fn consumer_config(cfg: &WorkerConfig, start: u64) -> pull::Config {
     }
 }
 
-/// Run a worker until `shutdown` resolves (module doc).
+/// Run a worker until `shutdown` resolves (module doc): [`prepare`], then
+/// [`run_prepared`].
 pub async fn run(
     fleet: &Fleet,
     cfg: &WorkerConfig,
     shutdown: impl Future<Output = ()>,
 ) -> Result<WorkerStats, FleetError> {
-    let mut consumer = prepare(fleet, cfg).await?;
+    let consumer = prepare(fleet, cfg).await?;
+    run_prepared(fleet, cfg, consumer, shutdown).await
+}
+
+/// Run a worker on `consumer`, the one [`prepare`] made, until `shutdown` resolves. A
+/// caller that prepared (to fail at once on a bad setup, then say it is waiting) hands
+/// the consumer over rather than asking for it again: from then on a consumer that loses
+/// its leader is the watch's to re-create ([`ConsumerWatch`]), not a start-up error.
+pub async fn run_prepared(
+    fleet: &Fleet,
+    cfg: &WorkerConfig,
+    mut consumer: PullConsumer,
+    shutdown: impl Future<Output = ()>,
+) -> Result<WorkerStats, FleetError> {
     let raw = fleet.raw_stream().await?;
     let mut watch = ConsumerWatch::new(
         tokio::time::Instant::now().into_std(),

@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use rotorid_fleet::drift::DriftSettings;
 use rotorid_fleet::nats::Fleet;
-use rotorid_fleet::worker::{run as run_worker, shutdown_signal, Scenarios, WorkerConfig};
+use rotorid_fleet::worker::{run_prepared, shutdown_signal, Scenarios, WorkerConfig};
 
 use crate::commands::identify::{method_of, IdentifyMethod, MethodOptions};
 
@@ -110,14 +110,14 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
         let fleet = Fleet::connect_reporting(&servers, Duration::from_secs(10), "worker")
             .await?
             .with_replicas(args.replicas)?;
-        rotorid_fleet::worker::prepare(&fleet, &cfg).await?;
+        let consumer = rotorid_fleet::worker::prepare(&fleet, &cfg).await?;
         crate::commands::fleet::report_shortfalls(&fleet, &servers, "worker").await?;
         eprintln!(
             "worker on {} (consumer {}): waiting for windows",
             fleet.server(),
             cfg.durable
         );
-        run_worker(&fleet, &cfg, shutdown_signal()).await
+        run_prepared(&fleet, &cfg, consumer, shutdown_signal()).await
     })?;
     eprintln!(
         "worker stopped: {} windows identified, {} dead-lettered, {} alerts",
