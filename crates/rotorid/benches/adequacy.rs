@@ -28,18 +28,7 @@ mod defects;
 fn record(clean: &TimeResponse) -> Record {
     let mut r = clean.clone();
     add_noise(&mut r, 40.0, 1).expect("valid noise");
-    Record::new(
-        r.t.clone(),
-        r.x.clone(),
-        r.z.clone(),
-        Speed::Samples {
-            phi: r.phi.clone(),
-            omega: r.phi_dot.clone(),
-            omega_dot: r.phi_ddot.clone(),
-        },
-        1e-6,
-    )
-    .expect("valid record")
+    Record::from_response(&r).expect("valid record")
 }
 
 /// The first `n` samples of `clean` + 40 dB of noise: the record an algebraic session

@@ -427,18 +427,7 @@ mod tests {
         let s = crate::Scenario::table1_ramp(600.0).expect("valid ramp");
         let mut r = simulate(&s, Method::Exact).expect("simulated");
         add_noise(&mut r, 40.0, 3).expect("valid noise");
-        let rec = Record::new(
-            r.t,
-            r.x,
-            r.z,
-            super::super::Speed::Samples {
-                phi: r.phi,
-                omega: r.phi_dot,
-                omega_dot: r.phi_ddot,
-            },
-            1e-6,
-        )
-        .expect("valid record");
+        let rec = Record::from_response(&r).expect("valid record");
         let start = s.rotor.params();
         let full = rec.for_refine();
         let tol = rk4_freq_tol(&full, &start, [noise_of(full.x), noise_of(full.z)]);
